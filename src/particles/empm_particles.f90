@@ -1,0 +1,115 @@
+!> Material points stored as a structure of arrays.
+!>
+!> Every per-particle quantity is a contiguous array whose last index is the particle.
+!> Tensors use Voigt order (xx, yy, zz, yz, xz, xy) with tensor (not engineering) shear strains.
+module empm_particles
+  use empm_kinds, only: wp
+  implicit none
+  private
+  public :: empm_particles_t
+
+  !> Particle state (structure of arrays).
+  type :: empm_particles_t
+    integer :: ndim = 0                     !! spatial dimension
+    integer :: np = 0                       !! number of particles in use
+    real(wp), allocatable :: x(:,:)         !! current position (ndim, np) [m]
+    real(wp), allocatable :: x0(:,:)        !! reference (initial) position (ndim, np) [m]
+    real(wp), allocatable :: v(:,:)         !! velocity (ndim, np) [m/s]
+    real(wp), allocatable :: a(:,:)         !! acceleration (ndim, np) [m/s²]
+    real(wp), allocatable :: m(:)           !! mass (np) [kg]
+    real(wp), allocatable :: vol(:)         !! current volume (np) [m³]
+    real(wp), allocatable :: vol0(:)        !! initial volume (np) [m³]
+    real(wp), allocatable :: rho(:)         !! current density (np) [kg/m³]
+    real(wp), allocatable :: stress(:,:)    !! Cauchy stress, Voigt (6, np) [Pa]
+    real(wp), allocatable :: strain(:,:)    !! accumulated small strain, Voigt (6, np)
+    real(wp), allocatable :: F(:,:,:)       !! deformation gradient (3, 3, np)
+    real(wp), allocatable :: L(:,:,:)       !! velocity gradient of the last step (3, 3, np) [1/s]
+    real(wp), allocatable :: lp(:,:)        !! half-length of the particle domain (ndim, np) [m]
+    real(wp), allocatable :: lam(:,:)       !! shape-function state (LME Lagrange multiplier) (ndim, np)
+    integer, allocatable :: mat(:)          !! material index (np)
+  contains
+    procedure :: alloc => particles_alloc
+    procedure :: append => particles_append
+    procedure :: copy_state_from => particles_copy_state
+  end type empm_particles_t
+
+contains
+
+  !> Allocate storage for `capacity` particles and set `np = 0`.
+  subroutine particles_alloc(self, ndim, capacity)
+    class(empm_particles_t), intent(inout) :: self !! particle set
+    integer, intent(in) :: ndim                    !! spatial dimension
+    integer, intent(in) :: capacity                !! number of particles to reserve
+    integer :: n
+    n = max(capacity, 0)
+    self%ndim = ndim
+    self%np = 0
+    if (allocated(self%x)) deallocate(self%x, self%x0, self%v, self%a, self%m, self%vol, self%vol0, &
+      self%rho, self%stress, self%strain, self%F, self%L, self%lp, self%lam, self%mat)
+    allocate(self%x(ndim, n), self%x0(ndim, n), self%v(ndim, n), self%a(ndim, n), &
+      self%m(n), self%vol(n), self%vol0(n), self%rho(n), self%stress(6, n), self%strain(6, n), &
+      self%F(3, 3, n), self%L(3, 3, n), self%lp(ndim, n), self%lam(ndim, n), self%mat(n))
+  end subroutine particles_alloc
+
+  !> Append one particle at rest, unstressed, with identity deformation gradient.
+  !> Grows the storage geometrically when full (set-up only, never in the time loop).
+  subroutine particles_append(self, x, vol, rho, lp, mat)
+    class(empm_particles_t), intent(inout) :: self !! particle set
+    real(wp), intent(in) :: x(:)                   !! position (ndim)
+    real(wp), intent(in) :: vol                    !! volume [m³]
+    real(wp), intent(in) :: rho                    !! density [kg/m³]
+    real(wp), intent(in) :: lp(:)                  !! half-lengths of the particle domain (ndim)
+    integer, intent(in) :: mat                     !! material index
+    type(empm_particles_t) :: tmp
+    integer :: n, d
+    if (.not. allocated(self%x)) call self%alloc(size(x), 64)
+    if (self%np == size(self%m)) then
+      call tmp%alloc(self%ndim, 2 * size(self%m))
+      call tmp%copy_state_from(self)
+      call move_alloc_all(tmp, self)
+    end if
+    n = self%np + 1
+    self%np = n
+    d = self%ndim
+    self%x(:, n) = x(1:d); self%x0(:, n) = x(1:d)
+    self%v(:, n) = 0.0_wp; self%a(:, n) = 0.0_wp
+    self%vol(n) = vol; self%vol0(n) = vol; self%rho(n) = rho; self%m(n) = rho * vol
+    self%stress(:, n) = 0.0_wp; self%strain(:, n) = 0.0_wp
+    self%F(:, :, n) = 0.0_wp; self%F(1, 1, n) = 1.0_wp; self%F(2, 2, n) = 1.0_wp
+    self%F(3, 3, n) = 1.0_wp
+    self%L(:, :, n) = 0.0_wp
+    self%lp(:, n) = lp(1:d); self%lam(:, n) = 0.0_wp
+    self%mat(n) = mat
+  end subroutine particles_append
+
+  !> Copy the first `src%np` particles of `src` into `self` (which must be large enough).
+  subroutine particles_copy_state(self, src)
+    class(empm_particles_t), intent(inout) :: self !! destination (allocated, capacity >= src%np)
+    class(empm_particles_t), intent(in) :: src     !! source
+    integer :: n
+    n = src%np
+    self%np = n
+    self%x(:, 1:n) = src%x(:, 1:n); self%x0(:, 1:n) = src%x0(:, 1:n)
+    self%v(:, 1:n) = src%v(:, 1:n); self%a(:, 1:n) = src%a(:, 1:n)
+    self%m(1:n) = src%m(1:n); self%vol(1:n) = src%vol(1:n); self%vol0(1:n) = src%vol0(1:n)
+    self%rho(1:n) = src%rho(1:n)
+    self%stress(:, 1:n) = src%stress(:, 1:n); self%strain(:, 1:n) = src%strain(:, 1:n)
+    self%F(:, :, 1:n) = src%F(:, :, 1:n); self%L(:, :, 1:n) = src%L(:, :, 1:n)
+    self%lp(:, 1:n) = src%lp(:, 1:n); self%lam(:, 1:n) = src%lam(:, 1:n)
+    self%mat(1:n) = src%mat(1:n)
+  end subroutine particles_copy_state
+
+  subroutine move_alloc_all(from, to)
+    type(empm_particles_t), intent(inout) :: from
+    class(empm_particles_t), intent(inout) :: to
+    to%np = from%np
+    call move_alloc(from%x, to%x); call move_alloc(from%x0, to%x0)
+    call move_alloc(from%v, to%v); call move_alloc(from%a, to%a)
+    call move_alloc(from%m, to%m); call move_alloc(from%vol, to%vol)
+    call move_alloc(from%vol0, to%vol0); call move_alloc(from%rho, to%rho)
+    call move_alloc(from%stress, to%stress); call move_alloc(from%strain, to%strain)
+    call move_alloc(from%F, to%F); call move_alloc(from%L, to%L)
+    call move_alloc(from%lp, to%lp); call move_alloc(from%lam, to%lam)
+    call move_alloc(from%mat, to%mat)
+  end subroutine move_alloc_all
+end module empm_particles
