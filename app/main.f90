@@ -1,5 +1,79 @@
+!> The `empm` command: run case files, print help and version.
 program empm_main
-  use empm, only: empm_version
+  use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
+  use empm, only: empm_version, empm_run_case, empm_error_t
   implicit none
-  print '(a)', empm_version()
+  integer :: nargs, i, ios
+  character(len=:), allocatable :: cmd, case_file, out_file, written
+  type(empm_error_t) :: err
+
+  nargs = command_argument_count()
+  if (nargs == 0) then
+    call usage(error_unit); error stop 1
+  end if
+  cmd = arg(1)
+  select case (cmd)
+  case ('-h', '--help', 'help')
+    call usage(output_unit)
+  case ('-V', '--version', 'version')
+    write(output_unit, '(a)') 'empm '//empm_version()
+  case ('run')
+    case_file = ''; out_file = ''
+    i = 2
+    do while (i <= nargs)
+      select case (arg(i))
+      case ('-o', '--output')
+        if (i == nargs) call die('option '//arg(i)//' needs a file name')
+        out_file = arg(i + 1); i = i + 2
+      case default
+        if (index(arg(i), '-') == 1) call die('unknown option '//arg(i))
+        if (len(case_file) > 0) call die('only one case file per run (got '//case_file// &
+                                         ' and '//arg(i)//')')
+        case_file = arg(i); i = i + 1
+      end select
+    end do
+    if (len(case_file) == 0) call die('empm run needs a case file: empm run CASE.nml')
+    call empm_run_case(case_file, out_file, written=written, err=err)
+    if (err%code /= 0) then
+      write(error_unit, '(a)') 'empm: error: '//err%message
+      select case (err%code)
+      case (2); error stop 2
+      case (3); error stop 3
+      case default; error stop 4
+      end select
+    end if
+    write(output_unit, '(a)', iostat=ios) 'empm: wrote '//written
+  case default
+    call die('unknown command '''//cmd//'''')
+  end select
+
+contains
+
+  function arg(k) result(s)
+    integer, intent(in) :: k
+    character(len=:), allocatable :: s
+    integer :: n
+    call get_command_argument(k, length=n)
+    allocate(character(len=n) :: s)
+    call get_command_argument(k, s)
+  end function arg
+
+  subroutine die(msg)
+    character(len=*), intent(in) :: msg
+    write(error_unit, '(a)') 'empm: '//msg//' (see empm --help)'
+    error stop 1
+  end subroutine die
+
+  subroutine usage(u)
+    integer, intent(in) :: u
+    write(u, '(a)') 'usage: empm run CASE.nml [-o OUT.h5]'
+    write(u, '(a)') '       empm --help | --version'
+    write(u, '(a)') ''
+    write(u, '(a)') 'Runs an explicit MPM simulation described by a namelist case file'
+    write(u, '(a)') '(keys: docs/input.md) and writes HDF5 results plus an XDMF file for'
+    write(u, '(a)') 'ParaView (layout: docs/output.md).'
+    write(u, '(a)') ''
+    write(u, '(a)') 'exit status: 0 success, 1 usage error, 2 invalid case file,'
+    write(u, '(a)') '             3 run stopped by a guard (results marked incomplete), 4 I/O error'
+  end subroutine usage
 end program empm_main

@@ -1,9 +1,55 @@
-!> Umbrella module: the public API of empm in one `use`.
+!> Umbrella module: the public API of empm in one `use empm`.
+!>
+!> Embedding codes can either drive a case file ([[empm_run_case]]) or assemble a model
+!> themselves: grid, particles, shape family, materials, loads and constraints, then
+!> [[empm_solve]] with an integrator. Extension points: [[empm_shape_t]],
+!> [[empm_material_t]], [[empm_integrator_t]].
 module empm
-  use empm_kinds, only: wp
+  use empm_kinds, only: wp, pi
   use empm_version_info, only: empm_version
-  use empm_error, only: empm_error_t
+  use empm_error, only: empm_error_t, EMPM_OK, EMPM_ERR_USAGE, EMPM_ERR_INPUT, &
+                        EMPM_ERR_RUNTIME, EMPM_ERR_IO
+  use empm_tensor, only: voigt_to_mat, mat_to_voigt
+  use empm_grid, only: empm_grid_t
+  use empm_nodes, only: empm_nodes_t
+  use empm_particles, only: empm_particles_t
+  use empm_particle_gen, only: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
+  use empm_shape, only: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK
+  use empm_shape_factory, only: empm_shape_create, empm_shape_names
+  use empm_material, only: empm_material_t
+  use empm_material_factory, only: empm_material_create, material_status_text
+  use empm_loads, only: empm_loads_t, empm_body_force_cb, RAMP_NONE, RAMP_SINE
+  use empm_model, only: empm_model_t, empm_material_slot_t, empm_step_status_t, STEP_OK
+  use empm_integrator, only: empm_integrator_t
+  use empm_integrator_factory, only: empm_integrator_create, empm_integrator_names
+  use empm_history, only: empm_history_t, empm_snapshot_t
+  use empm_solver, only: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
+  use empm_output, only: empm_write_results, empm_output_meta_t
+  use empm_driver, only: empm_run_case
+  use empm_exact_bar, only: empm_vibrating_bar_t
+  use empm_spectrum, only: empm_power_spectrum, empm_energy_share_above
+  use empm_linalg, only: empm_eigenvalues, empm_spectral_radius
   implicit none
   private
-  public :: wp, empm_version, empm_error_t
+  ! Kinds, version, errors
+  public :: wp, pi, empm_version, empm_error_t
+  public :: EMPM_OK, EMPM_ERR_USAGE, EMPM_ERR_INPUT, EMPM_ERR_RUNTIME, EMPM_ERR_IO
+  public :: voigt_to_mat, mat_to_voigt
+  ! Discretisation
+  public :: empm_grid_t, empm_nodes_t, empm_particles_t
+  public :: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
+  public :: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK
+  public :: empm_shape_create, empm_shape_names
+  ! Materials and loads
+  public :: empm_material_t, empm_material_create, material_status_text
+  public :: empm_loads_t, empm_body_force_cb, RAMP_NONE, RAMP_SINE
+  ! Model, integrators, solver, output
+  public :: empm_model_t, empm_material_slot_t, empm_step_status_t, STEP_OK
+  public :: empm_integrator_t, empm_integrator_create, empm_integrator_names
+  public :: empm_history_t, empm_snapshot_t
+  public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
+  public :: empm_write_results, empm_output_meta_t, empm_run_case
+  ! Analysis: exact solutions, spectra, eigenvalues
+  public :: empm_vibrating_bar_t, empm_power_spectrum, empm_energy_share_above
+  public :: empm_eigenvalues, empm_spectral_radius
 end module empm

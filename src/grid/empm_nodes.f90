@@ -1,0 +1,83 @@
+!> Nodal (grid) fields, rebuilt from the particles every step, and the Dirichlet constraints.
+module empm_nodes
+  use empm_kinds, only: wp
+  use empm_grid, only: empm_grid_t
+  implicit none
+  private
+  public :: empm_nodes_t
+
+  !> Nodal fields (structure of arrays, node index last).
+  type :: empm_nodes_t
+    integer :: ndim = 0                     !! spatial dimension
+    integer :: nnode = 0                    !! number of nodes
+    real(wp) :: mass_tol = 0.0_wp           !! nodes lighter than this are treated as empty [kg]
+    real(wp), allocatable :: mass(:)        !! lumped mass m_I (nnode) [kg]
+    real(wp), allocatable :: mom(:,:)       !! momentum p_I (ndim, nnode) [kg m/s]
+    real(wp), allocatable :: vel(:,:)       !! velocity v_I (ndim, nnode) [m/s]
+    real(wp), allocatable :: force(:,:)     !! total force f_I (ndim, nnode) [N]
+    real(wp), allocatable :: acc(:,:)       !! acceleration a_I = f_I/m_I (ndim, nnode) [m/s²]
+    real(wp), allocatable :: work(:,:)      !! scratch nodal vector (ndim, nnode)
+    logical, allocatable :: fixed(:,:)      !! Dirichlet mask per dof (ndim, nnode)
+    real(wp), allocatable :: vfix(:,:)      !! prescribed velocity on fixed dofs (ndim, nnode) [m/s]
+  contains
+    procedure :: alloc => nodes_alloc
+    procedure :: reset => nodes_reset
+    procedure :: fix_box => nodes_fix_box
+  end type empm_nodes_t
+
+contains
+
+  !> Allocate nodal storage for `grid`; no dof fixed.
+  subroutine nodes_alloc(self, grid)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields
+    type(empm_grid_t), intent(in) :: grid      !! background grid
+    integer :: d, n
+    d = grid%ndim; n = grid%nnode
+    self%ndim = d; self%nnode = n
+    if (allocated(self%mass)) deallocate(self%mass, self%mom, self%vel, self%force, self%acc, &
+      self%work, self%fixed, self%vfix)
+    allocate(self%mass(n), self%mom(d, n), self%vel(d, n), self%force(d, n), self%acc(d, n), &
+      self%work(d, n), self%fixed(d, n), self%vfix(d, n))
+    self%fixed = .false.; self%vfix = 0.0_wp
+    call self%reset()
+  end subroutine nodes_alloc
+
+  !> Zero every nodal field (step 9 of the paper's algorithm); constraints are kept.
+  subroutine nodes_reset(self)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields
+    self%mass = 0.0_wp; self%mom = 0.0_wp; self%vel = 0.0_wp
+    self%force = 0.0_wp; self%acc = 0.0_wp
+  end subroutine nodes_reset
+
+  !> Constrain components `comp` of every node inside the closed box [lo, hi] (a node set by
+  !> geometry) to the velocity `value`. Returns the number of nodes selected. Allocates the
+  !> nodal storage on first use.
+  subroutine nodes_fix_box(self, grid, lo, hi, comp, value, nsel)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields
+    type(empm_grid_t), intent(in) :: grid      !! background grid
+    real(wp), intent(in) :: lo(3)              !! lower corner of the selection box [m]
+    real(wp), intent(in) :: hi(3)              !! upper corner of the selection box [m]
+    logical, intent(in) :: comp(3)             !! which velocity components to prescribe
+    real(wp), intent(in) :: value(3)           !! prescribed velocity components [m/s]
+    integer, intent(out) :: nsel               !! number of nodes selected
+    real(wp) :: xi(3), tol
+    integer :: id, d
+    if (.not. allocated(self%mass) .or. self%nnode /= grid%nnode) call self%alloc(grid)
+    ! A node counts as inside when within a small fraction of a cell of the box.
+    tol = 1.0e-9_wp * grid%hmin()
+    nsel = 0
+    do id = 1, grid%nnode
+      xi = grid%node_coord(id)
+      if (all(xi(1:grid%ndim) >= lo(1:grid%ndim) - tol .and. &
+              xi(1:grid%ndim) <= hi(1:grid%ndim) + tol)) then
+        nsel = nsel + 1
+        do d = 1, grid%ndim
+          if (comp(d)) then
+            self%fixed(d, id) = .true.
+            self%vfix(d, id) = value(d)
+          end if
+        end do
+      end if
+    end do
+  end subroutine nodes_fix_box
+end module empm_nodes

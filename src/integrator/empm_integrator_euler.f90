@@ -1,0 +1,93 @@
+!> Forward-Euler MPM schemes: USF, USL (Sulsky et al. 1994; paper eqs. 21–22) and MUSL
+!> (the momentum-based modified update of Zhang et al. 2016; paper eqs. 23–24).
+!>
+!> All three advance particle velocities with the nodal acceleration and positions with the
+!> updated nodal velocity: v_p += Δt Σ N_Ip f_I/m_I, x_p += Δt Σ N_Ip p_I^{k+1}/m_I (eqs. 23–24
+!> written with the momentum to avoid dividing accelerations by tiny masses). They differ only
+!> in when and with which nodal velocity the stress is updated:
+!> - USF: before the forces, with v_I^k = p_I^k/m_I;
+!> - USL: after the particle update, with the updated nodal velocity v_I^{k+1};
+!> - MUSL: after the particle update, with velocities re-mapped from the updated particles.
+module empm_integrator_euler
+  use empm_kinds, only: wp
+  use empm_integrator, only: empm_integrator_t, eval_basis, update_stress
+  use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
+  use empm_transfer, only: p2g_mass, p2g_weighted, g2p_add_scaled, g2p_value, &
+                           velocity_gradient, nodal_divide_by_mass, constrain_velocity
+  implicit none
+  private
+  public :: empm_euler_t, EULER_USF, EULER_USL, EULER_MUSL
+
+  integer, parameter :: EULER_USF = 1  !! update stress first
+  integer, parameter :: EULER_USL = 2  !! update stress last
+  integer, parameter :: EULER_MUSL = 3 !! modified update stress last
+
+  !> Forward-Euler family.
+  type, extends(empm_integrator_t) :: empm_euler_t
+    integer :: variant = EULER_MUSL !! EULER_USF, EULER_USL or EULER_MUSL
+  contains
+    procedure :: step => euler_step
+    procedure :: name => euler_name
+  end type empm_euler_t
+
+contains
+
+  !> Identifier: "usf", "usl" or "musl".
+  function euler_name(self) result(s)
+    class(empm_euler_t), intent(in) :: self !! integrator
+    character(len=:), allocatable :: s      !! identifier
+    select case (self%variant)
+    case (EULER_USF); s = 'usf'
+    case (EULER_USL); s = 'usl'
+    case default;     s = 'musl'
+    end select
+  end function euler_name
+
+  !> One forward-Euler step.
+  subroutine euler_step(self, model, dt, stat)
+    class(empm_euler_t), intent(inout) :: self      !! integrator
+    type(empm_model_t), intent(inout) :: model      !! simulation state
+    real(wp), intent(in) :: dt                      !! time step [s]
+    type(empm_step_status_t), intent(out) :: stat   !! outcome
+    associate (nodes => model%nodes, pts => model%pts, basis => model%basis)
+      call eval_basis(model, stat)
+      if (stat%code /= STEP_OK) return
+      call nodes%reset()
+      call p2g_mass(basis, pts%m, nodes%mass)
+      call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom)
+      call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
+      call constrain_velocity(nodes, nodes%vel, nodes%mom)
+
+      if (self%variant == EULER_USF) then
+        call velocity_gradient(basis, nodes%vel, pts%L)
+        call update_stress(model, dt, stat)
+        if (stat%code /= STEP_OK) return
+      end if
+
+      call self%assemble_forces(model, model%t)
+      ! p^{k+1} = p^k + Δt f, then the constraints on the new nodal velocity.
+      nodes%mom = nodes%mom + dt * nodes%force
+      call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
+      call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
+      call constrain_velocity(nodes, nodes%vel, nodes%mom)
+
+      call g2p_value(basis, nodes%acc, pts%a)
+      call g2p_add_scaled(basis, dt, nodes%acc, pts%v)
+      call g2p_add_scaled(basis, dt, nodes%vel, pts%x)
+
+      select case (self%variant)
+      case (EULER_USL)
+        call velocity_gradient(basis, nodes%vel, pts%L)
+        call update_stress(model, dt, stat)
+      case (EULER_MUSL)
+        ! Re-map momentum from the updated particle velocities (Sulsky's MUSL).
+        nodes%mom = 0.0_wp
+        call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom)
+        call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
+        call constrain_velocity(nodes, nodes%vel, nodes%mom)
+        call velocity_gradient(basis, nodes%vel, pts%L)
+        call update_stress(model, dt, stat)
+      end select
+    end associate
+  end subroutine euler_step
+end module empm_integrator_euler

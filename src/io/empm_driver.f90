@@ -1,0 +1,58 @@
+!> High-level driver: read a case file, run it, write the results. Used by the `empm run`
+!> command and callable from embedding codes.
+module empm_driver
+    use empm_error, only: empm_error_t, empm_raise, EMPM_OK
+  use empm_case, only: empm_case_t
+  use empm_input, only: empm_read_case
+  use empm_history, only: empm_history_t
+  use empm_solver, only: empm_solve
+  use empm_output, only: empm_write_results, empm_output_meta_t
+  implicit none
+  private
+  public :: empm_run_case
+
+contains
+
+  !> Run the case in `path`, writing HDF5 to `output` (default: the case's &output file).
+  !> Exit-status semantics when `err` is absent: 2 invalid input, 3 run-time guard, 4 I/O.
+  !> A run stopped by a guard still writes its last good state, marked incomplete.
+  subroutine empm_run_case(path, output, progress, written, err)
+    character(len=*), intent(in) :: path                !! case file
+    character(len=*), intent(in), optional :: output    !! output HDF5 path override
+    logical, intent(in), optional :: progress           !! progress line on a terminal (default on)
+    character(len=:), allocatable, intent(out), optional :: written !! path of the HDF5 file
+    type(empm_error_t), intent(out), optional :: err    !! error, if present
+    type(empm_case_t) :: cs
+    type(empm_history_t) :: hist
+    type(empm_error_t) :: e, ew
+    type(empm_output_meta_t) :: meta
+
+    call empm_read_case(path, cs, e)
+    if (e%code /= EMPM_OK) then
+      call empm_raise(e%code, e%message, err); return
+    end if
+    if (present(output)) then
+      if (len_trim(output) > 0) cs%output_file = trim(output)
+    end if
+    if (present(progress)) cs%run%progress = progress
+    call hist%init(cs%model%grid%ndim, cs%probe_name, cs%probe_particle, 1024, &
+                   size(cs%run%snapshot_times))
+    call empm_solve(cs%model, cs%integ, cs%run, hist, e)
+
+    meta%case_file = path; meta%case_text = cs%text
+    meta%shape = cs%shape_name; meta%integrator = cs%scheme_name
+    meta%cfl = cs%run%cfl; meta%t_end = cs%run%t_end
+    if (e%code == EMPM_OK) then
+      call empm_write_results(cs%output_file, cs%model, hist, meta, .true., '', ew)
+    else
+      call empm_write_results(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
+    end if
+    if (present(written)) written = cs%output_file
+    if (e%code /= EMPM_OK) then
+      call empm_raise(e%code, e%message//' (last good state written to '//cs%output_file// &
+        ', marked incomplete)', err)
+    else if (ew%code /= EMPM_OK) then
+      call empm_raise(ew%code, ew%message, err)
+    end if
+  end subroutine empm_run_case
+end module empm_driver

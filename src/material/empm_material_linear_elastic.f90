@@ -1,0 +1,156 @@
+!> Isotropic linear elasticity, small-strain hypoelastic update (paper eqs. 2–4, 18–19).
+!>
+!> Each step: Δε = Δt·sym(L), ε ← ε + Δε, σ ← σ + D:Δε with the isotropic D (Lamé λ, μ),
+!> ρ ← ρ/(1 + tr Δε) (eq. 19). 1D uniaxial strain and 2D plane strain need no special case:
+!> the velocity gradient is zero in the unused directions, so the lateral stresses come out
+!> as λ·tr Δε by themselves. F ← (I + Δt L) F is kept for output only; the stress does not use it.
+!>
+!> The module also holds what every isotropic elastic model shares: the parameter check
+!> [[empm_elastic_check]], the Lamé conversion [[empm_lame]] and the `MAT_*` status codes.
+module empm_material_linear_elastic
+  use empm_kinds, only: wp
+  use empm_material, only: empm_material_t
+  use empm_tensor, only: identity3, voigt_ddot
+  implicit none
+  private
+  public :: empm_linear_elastic_t, empm_elastic_check, empm_lame
+  public :: MAT_OK, MAT_BAD_E, MAT_BAD_NU, MAT_BAD_RHO0
+
+  integer, parameter :: MAT_OK = 0       !! parameters valid / update succeeded
+  integer, parameter :: MAT_BAD_E = 2    !! Young's modulus not in (0, huge)
+  integer, parameter :: MAT_BAD_NU = 3   !! Poisson's ratio not in (−1, 0.5)
+  integer, parameter :: MAT_BAD_RHO0 = 4 !! reference density not in (0, huge)
+
+  !> Isotropic small-strain linear-elastic material.
+  type, extends(empm_material_t) :: empm_linear_elastic_t
+    real(wp) :: E = 0.0_wp      !! Young's modulus [Pa]
+    real(wp) :: nu = 0.0_wp     !! Poisson's ratio [-]
+    real(wp) :: lambda = 0.0_wp !! first Lamé parameter [Pa]
+    real(wp) :: mu = 0.0_wp     !! shear modulus [Pa]
+  contains
+    procedure :: init => le_init
+    procedure :: update => le_update
+    procedure :: wave_speed => le_wave_speed
+    procedure :: energy_density => le_energy_density
+    procedure :: name => le_name
+  end type empm_linear_elastic_t
+
+contains
+
+  !> Check isotropic elastic constants: `MAT_OK`, or the code of the first invalid one.
+  !> NaN fails every test (comparisons with NaN are false), so it is rejected too.
+  pure integer function empm_elastic_check(E, nu, rho0) result(info)
+    real(wp), intent(in) :: E    !! Young's modulus [Pa], must be in (0, huge)
+    real(wp), intent(in) :: nu   !! Poisson's ratio, must be in (−1, 0.5)
+    real(wp), intent(in) :: rho0 !! reference density [kg/m³], must be in (0, huge)
+    info = MAT_OK
+    if (.not. (E > 0.0_wp .and. E <= huge(E))) then
+      info = MAT_BAD_E
+    else if (.not. (nu > -1.0_wp .and. nu < 0.5_wp)) then
+      info = MAT_BAD_NU
+    else if (.not. (rho0 > 0.0_wp .and. rho0 <= huge(rho0))) then
+      info = MAT_BAD_RHO0
+    end if
+  end function empm_elastic_check
+
+  !> Lamé parameters from Young's modulus and Poisson's ratio (valid E, ν assumed).
+  pure subroutine empm_lame(E, nu, lambda, mu)
+    real(wp), intent(in) :: E       !! Young's modulus [Pa]
+    real(wp), intent(in) :: nu      !! Poisson's ratio, in (−1, 0.5)
+    real(wp), intent(out) :: lambda !! λ = Eν/((1+ν)(1−2ν)) [Pa]
+    real(wp), intent(out) :: mu     !! μ = E/(2(1+ν)) [Pa]
+    lambda = E * nu / ((1.0_wp + nu) * (1.0_wp - 2.0_wp * nu))
+    mu = E / (2.0_wp * (1.0_wp + nu))
+  end subroutine empm_lame
+
+  !> Set the constants after validating them; on failure `self` is left unchanged.
+  pure subroutine le_init(self, E, nu, rho0, info)
+    class(empm_linear_elastic_t), intent(inout) :: self !! material
+    real(wp), intent(in) :: E                           !! Young's modulus [Pa], > 0
+    real(wp), intent(in) :: nu                          !! Poisson's ratio, in (−1, 0.5)
+    real(wp), intent(in) :: rho0                        !! reference density [kg/m³], > 0
+    integer, intent(out) :: info                        !! `MAT_OK` or `MAT_BAD_E|NU|RHO0`
+    info = empm_elastic_check(E, nu, rho0)
+    if (info /= MAT_OK) return
+    self%E = E
+    self%nu = nu
+    self%rho0 = rho0
+    call empm_lame(E, nu, self%lambda, self%mu)
+  end subroutine le_init
+
+  !> Hypoelastic update of `n = size(rho)` particles (see the module notes).
+  !> `info = k > 0`: 1 + tr Δε <= 0 at particle k (the first such), whose state is left
+  !> unchanged (the other particles are updated); `info = -1`: array extents disagree with n.
+  pure subroutine le_update(self, dt, L, F, strain, stress, rho, info)
+    class(empm_linear_elastic_t), intent(in) :: self !! material
+    real(wp), intent(in) :: dt                       !! time step [s]
+    real(wp), intent(in) :: L(:,:,:)                 !! velocity gradient (3,3,n) [1/s]
+    real(wp), intent(inout) :: F(:,:,:)              !! deformation gradient (3,3,n)
+    real(wp), intent(inout) :: strain(:,:)           !! small strain, Voigt (6,n)
+    real(wp), intent(inout) :: stress(:,:)           !! Cauchy stress, Voigt (6,n) [Pa]
+    real(wp), intent(inout) :: rho(:)                !! density (n) [kg/m³]
+    integer, intent(out) :: info                     !! 0 ok; k > 0 particle k failed; −1 shapes
+    real(wp) :: de(6), tr, eye(3,3)
+    integer :: p, n
+    info = 0
+    n = size(rho)
+    if (size(L, 3) /= n .or. size(F, 3) /= n .or. size(strain, 2) /= n &
+        .or. size(stress, 2) /= n) then
+      info = -1
+      return
+    end if
+    eye = identity3()
+    do p = 1, n
+      de(1) = dt * L(1,1,p)
+      de(2) = dt * L(2,2,p)
+      de(3) = dt * L(3,3,p)
+      de(4) = 0.5_wp * dt * (L(2,3,p) + L(3,2,p))
+      de(5) = 0.5_wp * dt * (L(1,3,p) + L(3,1,p))
+      de(6) = 0.5_wp * dt * (L(1,2,p) + L(2,1,p))
+      tr = de(1) + de(2) + de(3)
+      ! eq. (19) integrated over the step; a non-positive volume ratio is unphysical.
+      if (1.0_wp + tr <= 0.0_wp) then
+        if (info == 0) info = p
+        cycle
+      end if
+      strain(:,p) = strain(:,p) + de
+      stress(1:3,p) = stress(1:3,p) + self%lambda * tr + 2.0_wp * self%mu * de(1:3)
+      stress(4:6,p) = stress(4:6,p) + 2.0_wp * self%mu * de(4:6)
+      rho(p) = rho(p) / (1.0_wp + tr)
+      F(:,:,p) = matmul(eye + dt * L(:,:,p), F(:,:,p))
+    end do
+  end subroutine le_update
+
+  !> P-wave speed sqrt((λ + 2μ)/ρ) [m/s].
+  pure real(wp) function le_wave_speed(self, rho)
+    class(empm_linear_elastic_t), intent(in) :: self !! material
+    real(wp), intent(in) :: rho                      !! current density [kg/m³]
+    le_wave_speed = sqrt((self%lambda + 2.0_wp * self%mu) / rho)
+  end function le_wave_speed
+
+  !> Energy density ½ σ:ε per current volume (small strain: current ≈ reference volume).
+  !> Exact for a stress built from zero by this model; F is not needed.
+  pure subroutine le_energy_density(self, F, strain, stress, psi)
+    class(empm_linear_elastic_t), intent(in) :: self !! material
+    real(wp), intent(in) :: F(:,:,:)                 !! deformation gradient (3,3,n), unused
+    real(wp), intent(in) :: strain(:,:)              !! small strain, Voigt (6,n)
+    real(wp), intent(in) :: stress(:,:)              !! Cauchy stress, Voigt (6,n) [Pa]
+    real(wp), intent(out) :: psi(:)                  !! ½ σ:ε (n) [J/m³]
+    integer :: p
+    ! Bound by every extent so that a short argument can never be read past its end.
+    do p = 1, min(size(psi), size(strain, 2), size(stress, 2), size(F, 3))
+      psi(p) = 0.5_wp * voigt_ddot(stress(:,p), strain(:,p))
+    end do
+    associate (unused => self) ! the energy needs no material constant
+    end associate
+  end subroutine le_energy_density
+
+  !> Identifier "linear_elastic".
+  function le_name(self) result(s)
+    class(empm_linear_elastic_t), intent(in) :: self !! material
+    character(len=:), allocatable :: s               !! "linear_elastic"
+    associate (unused => self) ! the binding needs `self`; the name does not
+    end associate
+    s = 'linear_elastic'
+  end function le_name
+end module empm_material_linear_elastic

@@ -1,0 +1,110 @@
+!> Particle generation: fill a box (interval in 1D) or a disk/sphere with n particles per cell
+!> direction, at Gauss–Legendre positions or at cell-centred voxel positions.
+module empm_particle_gen
+  use empm_kinds, only: wp
+  use empm_grid, only: empm_grid_t
+  use empm_particles, only: empm_particles_t
+  implicit none
+  private
+  public :: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
+
+  integer, parameter :: GEOM_BOX = 1     !! axis-aligned box [lo, hi] (interval in 1D)
+  integer, parameter :: GEOM_DISK = 2    !! disk (2D) or ball (3D) of given centre and radius
+  integer, parameter :: PLACE_GAUSS = 1  !! Gauss–Legendre points, volume = Gauss weight share
+  integer, parameter :: PLACE_VOXEL = 2  !! centres of ppc^d equal sub-cells (voxels)
+
+contains
+
+  !> Append the particles of one body. A candidate point (Gauss or voxel position of a grid
+  !> cell) is kept when it lies inside the geometry; its volume is the cell volume times its
+  !> quadrature weight share, and its half-length is half the voxel size (used by uGIMP).
+  subroutine empm_fill(pts, grid, geom, lo, hi, center, radius, ppc, placement, rho, mat, &
+                       nadded, info)
+    type(empm_particles_t), intent(inout) :: pts !! particle set (appended to)
+    type(empm_grid_t), intent(in) :: grid        !! background grid
+    integer, intent(in) :: geom                  !! GEOM_BOX or GEOM_DISK
+    real(wp), intent(in) :: lo(3), hi(3)         !! box corners (GEOM_BOX) [m]
+    real(wp), intent(in) :: center(3)            !! centre (GEOM_DISK) [m]
+    real(wp), intent(in) :: radius               !! radius (GEOM_DISK) [m]
+    integer, intent(in) :: ppc                   !! particles per cell and direction, 1..4
+    integer, intent(in) :: placement             !! PLACE_GAUSS or PLACE_VOXEL
+    real(wp), intent(in) :: rho                  !! density [kg/m³]
+    integer, intent(in) :: mat                   !! material index
+    integer, intent(out) :: nadded               !! particles added
+    integer, intent(out) :: info                 !! 0 ok, 1 bad ppc, 2 bad geometry/placement
+    real(wp) :: xi(4), wi(4), x(3), lp(3), w, cellvol
+    integer :: d, nd, c(3), s(3), cmax(3), k, c1, c2, c3
+    logical :: inside
+    nadded = 0; info = 0
+    nd = grid%ndim
+    if (ppc < 1 .or. ppc > 4) then
+      info = 1; return
+    end if
+    if ((geom /= GEOM_BOX .and. geom /= GEOM_DISK) .or. &
+        (placement /= PLACE_GAUSS .and. placement /= PLACE_VOXEL)) then
+      info = 2; return
+    end if
+    call points_1d(ppc, placement, xi, wi)
+    cellvol = product(grid%h(1:nd))
+    lp = 0.0_wp
+    lp(1:nd) = 0.5_wp * grid%h(1:nd) / ppc
+    cmax = 0; cmax(1:nd) = grid%ncell(1:nd) - 1
+    s = 1
+    do c3 = 0, cmax(3)
+      do c2 = 0, cmax(2)
+        do c1 = 0, cmax(1)
+          c = [c1, c2, c3]
+          do k = 0, ppc**nd - 1
+            ! Sub-point index per direction, x fastest.
+            s(1) = 1 + mod(k, ppc)
+            if (nd >= 2) s(2) = 1 + mod(k / ppc, ppc)
+            if (nd >= 3) s(3) = 1 + k / (ppc * ppc)
+            x = 0.0_wp; w = 1.0_wp
+            do d = 1, nd
+              x(d) = grid%origin(d) + (c(d) + 0.5_wp * (1.0_wp + xi(s(d)))) * grid%h(d)
+              w = w * wi(s(d))
+            end do
+            if (geom == GEOM_BOX) then
+              inside = all(x(1:nd) >= lo(1:nd) .and. x(1:nd) <= hi(1:nd))
+            else
+              inside = sum((x(1:nd) - center(1:nd))**2) <= radius**2
+            end if
+            if (inside) then
+              call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat)
+              nadded = nadded + 1
+            end if
+          end do
+        end do
+      end do
+    end do
+  end subroutine empm_fill
+
+  !> Reference coordinates in [−1, 1] and weight shares (summing to 1) of n points.
+  pure subroutine points_1d(n, placement, xi, wi)
+    integer, intent(in) :: n, placement
+    real(wp), intent(out) :: xi(4), wi(4)
+    integer :: i
+    xi = 0.0_wp; wi = 0.0_wp
+    if (placement == PLACE_VOXEL) then
+      do i = 1, n
+        xi(i) = -1.0_wp + (2.0_wp * i - 1.0_wp) / n
+        wi(i) = 1.0_wp / n
+      end do
+      return
+    end if
+    select case (n)
+    case (1)
+      xi(1) = 0.0_wp; wi(1) = 1.0_wp
+    case (2)
+      xi(1:2) = [-1.0_wp, 1.0_wp] / sqrt(3.0_wp); wi(1:2) = 0.5_wp
+    case (3)
+      xi(1:3) = [-sqrt(0.6_wp), 0.0_wp, sqrt(0.6_wp)]
+      wi(1:3) = [5.0_wp, 8.0_wp, 5.0_wp] / 18.0_wp
+    case default
+      xi = [-0.861136311594052575_wp, -0.339981043584856265_wp, &
+             0.339981043584856265_wp, 0.861136311594052575_wp]
+      wi = 0.5_wp * [0.347854845137453857_wp, 0.652145154862546143_wp, &
+                     0.652145154862546143_wp, 0.347854845137453857_wp]
+    end select
+  end subroutine points_1d
+end module empm_particle_gen

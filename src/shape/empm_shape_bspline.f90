@@ -1,0 +1,186 @@
+!> Uniform quadratic and cubic B-spline shape functions centred at the grid nodes.
+!>
+!> In 1D, with r = |x − x_I|/h:
+!>
+!> - quadratic (`order = 2`, support radius 1.5h, 3 nodes): 3/4 − r² for r < 1/2,
+!>   (3/2 − r)²/2 for 1/2 ≤ r < 3/2;
+!> - cubic (`order = 3`, support radius 2h, 4 nodes): 2/3 − r² + r³/2 for r < 1,
+!>   (2 − r)³/6 for 1 ≤ r < 2;
+!>
+!> and 0 beyond; in 2D and 3D the tensor product. Only nodes with a nonzero value are returned,
+!> so a generic point has (order+1)^ndim nodes (fewer when it sits on a breakpoint).
+!>
+!> Near the grid boundary the uniform B-spline needs nodes outside the grid: evaluation then
+!> returns `SHAPE_SUPPORT_CLIPPED`: for points closer than h/2 (quadratic) or h (cubic) to a
+!> grid face. The user must pad the grid by enough cells that material stays at least that far
+!> from every face (one padding cell suffices for both). Boundary-modified B-splines are
+!> future work. An `order` other than 2 or 3 gives `max_nodes = 0` and
+!> `SHAPE_TOO_MANY_NODES` (no storage can hold an undefined support).
+module empm_shape_bspline
+  use empm_kinds, only: wp
+  use empm_grid, only: empm_grid_t
+  use empm_particles, only: empm_particles_t
+  use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
+                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES
+  use empm_shape_linear, only: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, &
+                               shape_batch_fits
+  implicit none
+  private
+  public :: empm_shape_bspline_t, shape_bspline_kernel
+
+  !> Uniform B-spline shape functions of degree `order` (2 or 3).
+  type, extends(empm_shape_t) :: empm_shape_bspline_t
+    integer :: order = 3 !! polynomial degree: 2 (quadratic) or 3 (cubic)
+  contains
+    procedure :: max_nodes => bspline_max_nodes
+    procedure :: eval_point => bspline_eval_point
+    procedure :: eval_batch => bspline_eval_batch
+    procedure :: name => bspline_name
+  end type empm_shape_bspline_t
+
+contains
+
+  !> Upper bound on supporting nodes: (order+1)^ndim, or 0 for an unsupported order.
+  pure integer function bspline_max_nodes(self, grid)
+    class(empm_shape_bspline_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid           !! background grid
+    if (self%order == 2 .or. self%order == 3) then
+      bspline_max_nodes = (self%order + 1)**grid%ndim
+    else
+      bspline_max_nodes = 0
+    end if
+  end function bspline_max_nodes
+
+  !> Family identifier: "bspline2" or "bspline3" ("bspline?" for an unsupported order).
+  function bspline_name(self) result(s)
+    class(empm_shape_bspline_t), intent(in) :: self !! shape family
+    character(len=:), allocatable :: s              !! identifier
+    select case (self%order)
+    case (2); s = 'bspline2'
+    case (3); s = 'bspline3'
+    case default; s = 'bspline?'
+    end select
+  end function bspline_name
+
+  !> Values and gradients at one point (`lp` and `lam` are not used by this family).
+  subroutine bspline_eval_point(self, grid, x, lp, lam, nn, node, N, dN, info)
+    class(empm_shape_bspline_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid           !! background grid
+    real(wp), intent(in) :: x(:)                    !! point (ndim)
+    real(wp), intent(in) :: lp(:)                   !! particle half-lengths (unused)
+    real(wp), intent(inout) :: lam(:)               !! iterative state (unused, unchanged)
+    integer, intent(out) :: nn                      !! number of supporting nodes
+    integer, intent(out) :: node(:)                 !! supporting node indices
+    real(wp), intent(out) :: N(:)                   !! values
+    real(wp), intent(out) :: dN(:,:)                !! gradients (ndim, :)
+    integer, intent(out) :: info                    !! SHAPE_OK or a SHAPE_* failure code
+    associate (unused_lp_ => lp, unused_lam_ => lam); end associate
+    call shape_bspline_kernel(self%order, grid, x, nn, node, N, dN, info)
+  end subroutine bspline_eval_point
+
+  !> Values and gradients at particles 1..pts%np; stops at the first failing particle.
+  subroutine bspline_eval_batch(self, grid, pts, basis, ibad, info)
+    class(empm_shape_bspline_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid           !! background grid
+    type(empm_particles_t), intent(inout) :: pts    !! particles (unchanged)
+    type(empm_basis_t), intent(inout) :: basis      !! filled for particles 1..pts%np
+    integer, intent(out) :: ibad                    !! first failing particle, 0 if none
+    integer, intent(out) :: info                    !! SHAPE_OK or the failing particle's code
+    integer :: p
+    call shape_batch_fits(pts%np, basis, ibad, info)
+    if (info /= SHAPE_OK) return
+    do p = 1, pts%np
+      call shape_bspline_kernel(self%order, grid, pts%x(:, p), basis%nn(p), basis%node(:, p), &
+                                basis%N(:, p), basis%dN(:, :, p), info)
+      if (info /= SHAPE_OK) then
+        ibad = p
+        return
+      end if
+    end do
+  end subroutine bspline_eval_batch
+
+  !> B-spline shape functions of degree `order` at one point; only nodes with a nonzero value
+  !> are returned, in increasing index order.
+  pure subroutine shape_bspline_kernel(order, grid, x, nn, node, N, dN, info)
+    integer, intent(in) :: order          !! degree: 2 or 3
+    type(empm_grid_t), intent(in) :: grid !! background grid
+    real(wp), intent(in) :: x(:)          !! point (ndim)
+    integer, intent(out) :: nn            !! number of supporting nodes (0 on failure)
+    integer, intent(out) :: node(:)       !! supporting node indices (capacity >= (order+1)^ndim)
+    real(wp), intent(out) :: N(:)         !! values
+    real(wp), intent(out) :: dN(:,:)      !! gradients (ndim, :)
+    integer, intent(out) :: info          !! SHAPE_OK or a SHAPE_* failure code (see module)
+    integer :: m(3), base(3), d
+    real(wp) :: w(SHAPE_TP_MAXM, 3), g(SHAPE_TP_MAXM, 3)
+    nn = 0
+    if (order /= 2 .and. order /= 3) then
+      info = SHAPE_TOO_MANY_NODES; return
+    end if
+    if (grid%ndim < 1) then
+      info = SHAPE_OUTSIDE_GRID; return
+    end if
+    if (.not. grid%inside(x)) then
+      info = SHAPE_OUTSIDE_GRID; return
+    end if
+    call shape_tp_init(m, base, w, g)
+    do d = 1, grid%ndim
+      call bspline_1d(order, grid, d, x(d), m(d), base(d), w(:, d), g(:, d), info)
+      if (info /= SHAPE_OK) return
+    end do
+    call shape_tp_assemble(grid, m, base, w, g, nn, node, N, dN, info)
+  end subroutine shape_bspline_kernel
+
+  !> 1D B-spline factors along direction `d`: the nodes with a nonzero value.
+  pure subroutine bspline_1d(order, grid, d, xd, m, base, w, g, info)
+    integer, intent(in) :: order          !! degree: 2 or 3
+    type(empm_grid_t), intent(in) :: grid !! background grid
+    integer, intent(in) :: d              !! direction
+    real(wp), intent(in) :: xd            !! coordinate of the point (inside the grid)
+    integer, intent(out) :: m             !! number of nodes
+    integer, intent(out) :: base          !! 0-based index of the first node
+    real(wp), intent(out) :: w(:)         !! values
+    real(wp), intent(out) :: g(:)         !! derivatives with respect to x_d
+    integer, intent(out) :: info          !! SHAPE_OK or SHAPE_SUPPORT_CLIPPED
+    real(wp) :: s, u, r, radius, ih
+    integer :: i, i1
+    m = 0
+    base = 0
+    ih = grid%inv_h(d)
+    s = (xd - grid%origin(d)) * ih
+    radius = 0.5_wp * real(order + 1, wp)
+    ! Candidates i1 .. i1+order are the only nodes within `radius` of s; any that are dropped
+    ! (zero value or tolerated outside node) sit at the ends, so the kept ones are contiguous.
+    i1 = floor(s - 0.5_wp * real(order - 1, wp))
+    do i = i1, i1 + order
+      u = s - i
+      r = abs(u)
+      if (r >= radius) cycle
+      if (i < 0 .or. i > grid%ncell(d)) then
+        if (r < radius - SHAPE_CLIP_TOL) then
+          info = SHAPE_SUPPORT_CLIPPED; return
+        end if
+        cycle
+      end if
+      if (m == 0) base = i
+      m = m + 1
+      if (order == 2) then
+        if (r < 0.5_wp) then
+          w(m) = 0.75_wp - r * r
+          g(m) = -2.0_wp * u * ih
+        else
+          w(m) = 0.5_wp * (1.5_wp - r)**2
+          g(m) = -sign(1.0_wp, u) * (1.5_wp - r) * ih
+        end if
+      else
+        if (r < 1.0_wp) then
+          w(m) = 2.0_wp / 3.0_wp - r * r + 0.5_wp * r**3
+          g(m) = u * (1.5_wp * r - 2.0_wp) * ih
+        else
+          w(m) = (2.0_wp - r)**3 / 6.0_wp
+          g(m) = -sign(1.0_wp, u) * 0.5_wp * (2.0_wp - r)**2 * ih
+        end if
+      end if
+    end do
+    info = SHAPE_OK
+  end subroutine bspline_1d
+end module empm_shape_bspline

@@ -1,0 +1,216 @@
+!> Linear (tent) shape functions on the regular grid: 2-node bar (1D), Q4 (2D), H8 (3D).
+!>
+!> Also home of the tensor-product machinery shared by every grid-aligned family (linear,
+!> uGIMP, B-splines): each family computes 1D values and derivatives per direction, and
+!> [[shape_tp_assemble]] multiplies them out into node indices, values and gradients.
+!>
+!> The spatial dimension is taken from the grid (`grid%ndim`); `self%ndim` is set by the
+!> factory and is expected to agree with it.
+module empm_shape_linear
+  use empm_kinds, only: wp
+  use empm_grid, only: empm_grid_t
+  use empm_particles, only: empm_particles_t
+  use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
+                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES
+  implicit none
+  private
+  public :: empm_shape_linear_t, shape_linear_kernel
+  public :: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, shape_batch_fits
+
+  !> Most nodes per direction of any tensor-product family (cubic B-spline).
+  integer, parameter :: SHAPE_TP_MAXM = 4
+  !> Tolerance, in grid units, on the support edge when a node beyond the grid is involved:
+  !> a node whose distance to the point is within this of the support radius carries a weight
+  !> of order tol² (round-off of a particle domain that exactly touches the grid boundary), so
+  !> it is dropped instead of reporting SHAPE_SUPPORT_CLIPPED.
+  real(wp), parameter :: SHAPE_CLIP_TOL = 1.0e-10_wp
+
+  !> Linear tensor-product shape functions: 2^ndim nodes, those of the cell holding the point.
+  type, extends(empm_shape_t) :: empm_shape_linear_t
+  contains
+    procedure :: max_nodes => linear_max_nodes
+    procedure :: eval_point => linear_eval_point
+    procedure :: eval_batch => linear_eval_batch
+    procedure :: name => linear_name
+  end type empm_shape_linear_t
+
+contains
+
+  !> Upper bound on supporting nodes: 2^ndim.
+  pure integer function linear_max_nodes(self, grid)
+    class(empm_shape_linear_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid          !! background grid
+    associate (unused_ => self); end associate
+    linear_max_nodes = 2**grid%ndim
+  end function linear_max_nodes
+
+  !> Family identifier: "linear".
+  function linear_name(self) result(s)
+    class(empm_shape_linear_t), intent(in) :: self !! shape family
+    character(len=:), allocatable :: s             !! identifier
+    associate (unused_ => self); end associate
+    s = 'linear'
+  end function linear_name
+
+  !> Values and gradients at one point (`lp` and `lam` are not used by this family).
+  subroutine linear_eval_point(self, grid, x, lp, lam, nn, node, N, dN, info)
+    class(empm_shape_linear_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid          !! background grid
+    real(wp), intent(in) :: x(:)                   !! point (ndim)
+    real(wp), intent(in) :: lp(:)                  !! particle half-lengths (unused)
+    real(wp), intent(inout) :: lam(:)              !! iterative state (unused, unchanged)
+    integer, intent(out) :: nn                     !! number of supporting nodes (2^ndim)
+    integer, intent(out) :: node(:)                !! supporting node indices
+    real(wp), intent(out) :: N(:)                  !! values
+    real(wp), intent(out) :: dN(:,:)               !! gradients (ndim, :)
+    integer, intent(out) :: info                   !! SHAPE_OK or a SHAPE_* failure code
+    associate (unused_ => self, unused_lp_ => lp, unused_lam_ => lam); end associate
+    call shape_linear_kernel(grid, x, nn, node, N, dN, info)
+  end subroutine linear_eval_point
+
+  !> Values and gradients at particles 1..pts%np; stops at the first failing particle.
+  subroutine linear_eval_batch(self, grid, pts, basis, ibad, info)
+    class(empm_shape_linear_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid          !! background grid
+    type(empm_particles_t), intent(inout) :: pts   !! particles (unchanged)
+    type(empm_basis_t), intent(inout) :: basis     !! filled for particles 1..pts%np
+    integer, intent(out) :: ibad                   !! first failing particle, 0 if none
+    integer, intent(out) :: info                   !! SHAPE_OK or the failing particle's code
+    integer :: p
+    associate (unused_ => self); end associate
+    call shape_batch_fits(pts%np, basis, ibad, info)
+    if (info /= SHAPE_OK) return
+    do p = 1, pts%np
+      call shape_linear_kernel(grid, pts%x(:, p), basis%nn(p), basis%node(:, p), &
+                               basis%N(:, p), basis%dN(:, :, p), info)
+      if (info /= SHAPE_OK) then
+        ibad = p
+        return
+      end if
+    end do
+  end subroutine linear_eval_batch
+
+  !> Linear shape functions at one point: the 2^ndim nodes of the cell holding `x`.
+  !>
+  !> A point on a cell face belongs to the cell above it, except on the upper grid boundary
+  !> where the last cell is used, so every point of the closed grid box is accepted.
+  !> Nodes are returned in increasing index order; one of them may carry a zero value.
+  pure subroutine shape_linear_kernel(grid, x, nn, node, N, dN, info)
+    type(empm_grid_t), intent(in) :: grid !! background grid
+    real(wp), intent(in) :: x(:)          !! point (ndim)
+    integer, intent(out) :: nn            !! number of supporting nodes (0 on failure)
+    integer, intent(out) :: node(:)       !! supporting node indices (capacity >= 2^ndim)
+    real(wp), intent(out) :: N(:)         !! values (capacity >= 2^ndim)
+    real(wp), intent(out) :: dN(:,:)      !! gradients (ndim, capacity >= 2^ndim)
+    integer, intent(out) :: info          !! SHAPE_OK, SHAPE_OUTSIDE_GRID, SHAPE_TOO_MANY_NODES
+    integer :: m(3), base(3), d, i0
+    real(wp) :: w(SHAPE_TP_MAXM, 3), g(SHAPE_TP_MAXM, 3), s, t
+    nn = 0
+    if (grid%ndim < 1) then
+      info = SHAPE_OUTSIDE_GRID; return
+    end if
+    if (.not. grid%inside(x)) then
+      info = SHAPE_OUTSIDE_GRID; return
+    end if
+    call shape_tp_init(m, base, w, g)
+    do d = 1, grid%ndim
+      s = (x(d) - grid%origin(d)) * grid%inv_h(d)
+      ! Clamp: the upper boundary belongs to the last cell, and round-off in s must not
+      ! produce t slightly outside [0, 1] (a negative value).
+      i0 = min(max(floor(s), 0), grid%ncell(d) - 1)
+      t = min(max(s - i0, 0.0_wp), 1.0_wp)
+      m(d) = 2
+      base(d) = i0
+      w(1, d) = 1.0_wp - t
+      w(2, d) = t
+      g(1, d) = -grid%inv_h(d)
+      g(2, d) = grid%inv_h(d)
+    end do
+    call shape_tp_assemble(grid, m, base, w, g, nn, node, N, dN, info)
+  end subroutine shape_linear_kernel
+
+  !> Reset tensor-product factors to the neutral values used along directions beyond ndim:
+  !> one node at index 0 with value 1 and derivative 0.
+  pure subroutine shape_tp_init(m, base, w, g)
+    integer, intent(out) :: m(3)      !! nodes per direction
+    integer, intent(out) :: base(3)   !! 0-based index of the first node per direction
+    real(wp), intent(out) :: w(:,:)   !! 1D values (SHAPE_TP_MAXM, 3)
+    real(wp), intent(out) :: g(:,:)   !! 1D derivatives d/dx_d (SHAPE_TP_MAXM, 3)
+    m = 1
+    base = 0
+    w = 0.0_wp
+    w(1, :) = 1.0_wp
+    g = 0.0_wp
+  end subroutine shape_tp_init
+
+  !> Tensor product of 1D factors: node (base + k - 1) per direction gets value
+  !> Π_d w(k_d, d) and gradient component d given by replacing w(k_d, d) with g(k_d, d).
+  !> Nodes come out x fastest, i.e. in increasing node index.
+  pure subroutine shape_tp_assemble(grid, m, base, w, g, nn, node, N, dN, info)
+    type(empm_grid_t), intent(in) :: grid !! background grid
+    integer, intent(in) :: m(3)           !! nodes per direction (1 beyond ndim)
+    integer, intent(in) :: base(3)        !! 0-based index of the first node per direction
+    real(wp), intent(in) :: w(:,:)        !! 1D values (SHAPE_TP_MAXM, 3)
+    real(wp), intent(in) :: g(:,:)        !! 1D derivatives with respect to x_d
+    integer, intent(out) :: nn            !! number of nodes, product(m) (0 on failure)
+    integer, intent(out) :: node(:)       !! node indices
+    real(wp), intent(out) :: N(:)         !! values
+    real(wp), intent(out) :: dN(:,:)      !! gradients (ndim, :)
+    integer, intent(out) :: info          !! SHAPE_OK, SHAPE_TOO_MANY_NODES, SHAPE_SUPPORT_CLIPPED
+    integer :: nd, k1, k2, k3, a, ijk(3)
+    real(wp) :: w23, w13, w12
+    nd = grid%ndim
+    nn = 0
+    a = product(m)
+    if (a > size(node) .or. a > size(N) .or. a > size(dN, 2) .or. size(dN, 1) < nd) then
+      info = SHAPE_TOO_MANY_NODES; return
+    end if
+    a = 0
+    do k3 = 1, m(3)
+      do k2 = 1, m(2)
+        w23 = w(k2, 2) * w(k3, 3)
+        do k1 = 1, m(1)
+          a = a + 1
+          ijk = base + [k1, k2, k3] - 1
+          node(a) = grid%node_id(ijk)
+          ! Families only hand over nodes inside the grid; guard against a logic error.
+          if (node(a) == 0) then
+            info = SHAPE_SUPPORT_CLIPPED; return
+          end if
+          N(a) = w(k1, 1) * w23
+          dN(1, a) = g(k1, 1) * w23
+          if (nd >= 2) then
+            w13 = w(k1, 1) * w(k3, 3)
+            dN(2, a) = g(k2, 2) * w13
+          end if
+          if (nd >= 3) then
+            w12 = w(k1, 1) * w(k2, 2)
+            dN(3, a) = g(k3, 3) * w12
+          end if
+        end do
+      end do
+    end do
+    nn = a
+    info = SHAPE_OK
+  end subroutine shape_tp_assemble
+
+  !> Check that `basis` has storage for `np` particles before a batch (the per-particle
+  !> capacity and dimension are checked by [[shape_tp_assemble]]).
+  !> On failure `info = SHAPE_TOO_MANY_NODES` and `ibad` is the first particle without storage.
+  pure subroutine shape_batch_fits(np, basis, ibad, info)
+    integer, intent(in) :: np                  !! number of particles to evaluate
+    type(empm_basis_t), intent(in) :: basis    !! basis storage
+    integer, intent(out) :: ibad               !! 0, or the first particle that does not fit
+    integer, intent(out) :: info               !! SHAPE_OK or SHAPE_TOO_MANY_NODES
+    ibad = 0
+    info = SHAPE_OK
+    if (np <= 0) return
+    if (.not. allocated(basis%nn)) then
+      ibad = 1
+    else if (size(basis%nn) < np .or. size(basis%node, 2) < np .or. size(basis%N, 2) < np &
+             .or. size(basis%dN, 3) < np) then
+      ibad = min(size(basis%nn), size(basis%node, 2), size(basis%N, 2), size(basis%dN, 3)) + 1
+    end if
+    if (ibad /= 0) info = SHAPE_TOO_MANY_NODES
+  end subroutine shape_batch_fits
+end module empm_shape_linear

@@ -1,0 +1,118 @@
+!> In-memory record of a run: energy histories, probe histories and state snapshots.
+!> Filled by the solver, written to HDF5 by the output layer, or read directly by an
+!> embedding code.
+module empm_history
+  use empm_kinds, only: wp
+  use empm_particles, only: empm_particles_t
+  implicit none
+  private
+  public :: empm_history_t, empm_snapshot_t
+
+  !> Particle state at one time.
+  type :: empm_snapshot_t
+    real(wp) :: t = 0.0_wp               !! time [s]
+    integer :: step = 0                  !! step number
+    real(wp), allocatable :: x(:,:)      !! positions (ndim, np)
+    real(wp), allocatable :: v(:,:)      !! velocities (ndim, np)
+    real(wp), allocatable :: stress(:,:) !! stresses (6, np)
+    real(wp), allocatable :: strain(:,:) !! strains (6, np)
+    real(wp), allocatable :: m(:)        !! masses (np)
+    real(wp), allocatable :: vol(:)      !! volumes (np)
+    real(wp), allocatable :: rho(:)      !! densities (np)
+  end type empm_snapshot_t
+
+  !> Histories of a run.
+  type :: empm_history_t
+    integer :: nt = 0                        !! number of recorded history samples
+    integer :: nprobe = 0                    !! number of probes
+    character(len=64), allocatable :: probe_name(:)  !! probe names (nprobe)
+    integer, allocatable :: probe_particle(:)        !! particle followed by each probe
+    real(wp), allocatable :: t(:)            !! sample times (nt) [s]
+    real(wp), allocatable :: kinetic(:)      !! kinetic energy (nt) [J]
+    real(wp), allocatable :: strain(:)       !! stored elastic energy (nt) [J]
+    real(wp), allocatable :: gravity(:)      !! gravitational potential −Σ m g·x (nt) [J]
+    real(wp), allocatable :: px(:,:,:)       !! probe positions (ndim, nprobe, nt)
+    real(wp), allocatable :: pv(:,:,:)       !! probe velocities (ndim, nprobe, nt)
+    real(wp), allocatable :: ps(:,:,:)       !! probe stresses (6, nprobe, nt)
+    integer :: nsnap = 0                     !! snapshots taken
+    type(empm_snapshot_t), allocatable :: snap(:) !! snapshots (nsnap used)
+  contains
+    procedure :: init => history_init
+    procedure :: add_sample => history_add_sample
+    procedure :: add_snapshot => history_add_snapshot
+  end type empm_history_t
+
+contains
+
+  !> Prepare an empty record for `nprobe` probes following the given particles, with room for
+  !> `capacity` samples and `nsnap_max` snapshots.
+  subroutine history_init(self, ndim, names, particles, capacity, nsnap_max)
+    class(empm_history_t), intent(inout) :: self    !! record
+    integer, intent(in) :: ndim                     !! spatial dimension
+    character(len=*), intent(in) :: names(:)        !! probe names
+    integer, intent(in) :: particles(:)             !! particle index of each probe
+    integer, intent(in) :: capacity                 !! initial number of samples reserved
+    integer, intent(in) :: nsnap_max                !! number of snapshots reserved
+    integer :: n, c
+    n = size(particles); c = max(capacity, 16)
+    self%nt = 0; self%nprobe = n; self%nsnap = 0
+    if (allocated(self%t)) deallocate(self%t, self%kinetic, self%strain, self%gravity, &
+      self%px, self%pv, self%ps, self%probe_name, self%probe_particle)
+    if (allocated(self%snap)) deallocate(self%snap)
+    allocate(self%probe_name(n), self%probe_particle(n))
+    self%probe_name = names; self%probe_particle = particles
+    allocate(self%t(c), self%kinetic(c), self%strain(c), self%gravity(c), &
+      self%px(ndim, n, c), self%pv(ndim, n, c), self%ps(6, n, c), self%snap(max(nsnap_max, 1)))
+  end subroutine history_init
+
+  !> Append one sample. Storage grows geometrically when full (rare, amortised).
+  subroutine history_add_sample(self, t, ekin, estrain, egrav, pts)
+    class(empm_history_t), intent(inout) :: self !! record
+    real(wp), intent(in) :: t                    !! time [s]
+    real(wp), intent(in) :: ekin                 !! kinetic energy [J]
+    real(wp), intent(in) :: estrain              !! stored energy [J]
+    real(wp), intent(in) :: egrav                !! gravitational potential [J]
+    type(empm_particles_t), intent(in) :: pts    !! particles (probe values)
+    integer :: k, p
+    if (self%nt == size(self%t)) call grow(self)
+    k = self%nt + 1; self%nt = k
+    self%t(k) = t; self%kinetic(k) = ekin; self%strain(k) = estrain; self%gravity(k) = egrav
+    do p = 1, self%nprobe
+      self%px(:, p, k) = pts%x(:, self%probe_particle(p))
+      self%pv(:, p, k) = pts%v(:, self%probe_particle(p))
+      self%ps(:, p, k) = pts%stress(:, self%probe_particle(p))
+    end do
+  end subroutine history_add_sample
+
+  subroutine grow(self)
+    type(empm_history_t), intent(inout) :: self
+    real(wp), allocatable :: r1(:), r3(:,:,:)
+    integer :: n, c
+    n = self%nt; c = 2 * size(self%t)
+    allocate(r1(c)); r1(1:n) = self%t(1:n); call move_alloc(r1, self%t)
+    allocate(r1(c)); r1(1:n) = self%kinetic(1:n); call move_alloc(r1, self%kinetic)
+    allocate(r1(c)); r1(1:n) = self%strain(1:n); call move_alloc(r1, self%strain)
+    allocate(r1(c)); r1(1:n) = self%gravity(1:n); call move_alloc(r1, self%gravity)
+    allocate(r3(size(self%px, 1), self%nprobe, c)); r3(:, :, 1:n) = self%px(:, :, 1:n)
+    call move_alloc(r3, self%px)
+    allocate(r3(size(self%pv, 1), self%nprobe, c)); r3(:, :, 1:n) = self%pv(:, :, 1:n)
+    call move_alloc(r3, self%pv)
+    allocate(r3(6, self%nprobe, c)); r3(:, :, 1:n) = self%ps(:, :, 1:n)
+    call move_alloc(r3, self%ps)
+  end subroutine grow
+
+  !> Store a snapshot of the particle state (ignored beyond the reserved count).
+  subroutine history_add_snapshot(self, t, step, pts)
+    class(empm_history_t), intent(inout) :: self !! record
+    real(wp), intent(in) :: t                    !! time [s]
+    integer, intent(in) :: step                  !! step number
+    type(empm_particles_t), intent(in) :: pts    !! particles
+    integer :: k, n
+    if (self%nsnap >= size(self%snap)) return
+    k = self%nsnap + 1; self%nsnap = k; n = pts%np
+    self%snap(k)%t = t; self%snap(k)%step = step
+    self%snap(k)%x = pts%x(:, 1:n); self%snap(k)%v = pts%v(:, 1:n)
+    self%snap(k)%stress = pts%stress(:, 1:n); self%snap(k)%strain = pts%strain(:, 1:n)
+    self%snap(k)%m = pts%m(1:n); self%snap(k)%vol = pts%vol(1:n); self%snap(k)%rho = pts%rho(1:n)
+  end subroutine history_add_snapshot
+end module empm_history
