@@ -2,6 +2,7 @@
 program empm_main
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use empm, only: empm_version, empm_run_case, empm_error_t
+  use empm_terminal, only: empm_exit
   implicit none
   integer :: nargs, i, ios
   character(len=:), allocatable :: cmd, case_file, out_file, written
@@ -9,7 +10,7 @@ program empm_main
 
   nargs = command_argument_count()
   if (nargs == 0) then
-    call usage(error_unit); error stop 1
+    call usage(error_unit); call empm_exit(1)
   end if
   cmd = arg(1)
   select case (cmd)
@@ -36,11 +37,7 @@ program empm_main
     call empm_run_case(case_file, out_file, written=written, err=err)
     if (err%code /= 0) then
       write(error_unit, '(a)') 'empm: error: '//err%message
-      select case (err%code)
-      case (2); error stop 2
-      case (3); error stop 3
-      case default; error stop 4
-      end select
+      call empm_exit(err%code)
     end if
     write(output_unit, '(a)', iostat=ios) 'empm: wrote '//written
   case default
@@ -61,7 +58,7 @@ contains
   subroutine die(msg)
     character(len=*), intent(in) :: msg
     write(error_unit, '(a)') 'empm: '//msg//' (see empm --help)'
-    error stop 1
+    call empm_exit(1)
   end subroutine die
 
   subroutine usage(u)

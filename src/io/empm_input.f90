@@ -77,39 +77,103 @@ contains
     rewind(u)
   end subroutine slurp
 
-  !> Every `&name` in the file must be a known group (the namelist reader would skip others).
+  !> Valid keys of a group, space-separated ('' for an unknown group).
+  pure function group_keys(group) result(keys)
+    character(len=*), intent(in) :: group
+    character(len=:), allocatable :: keys
+    select case (group)
+    case ('grid'); keys = 'ndim origin h cells'
+    case ('material'); keys = 'name model e nu density'
+    case ('particles'); keys = 'material geometry lo hi center radius ppc placement velocity '// &
+      'velocity_sine_amplitude velocity_sine_wavenumber velocity_sine_phase stress'
+    case ('shape'); keys = 'family'
+    case ('integrator'); keys = 'scheme cfl dt t_end max_steps'
+    case ('loads'); keys = 'gravity ramp ramp_time'
+    case ('boundary'); keys = 'lo hi fix velocity'
+    case ('probe'); keys = 'name particle point'
+    case ('output'); keys = 'file history_every snapshot_times'
+    case default; keys = ''
+    end select
+  end function group_keys
+
+  !> Scan the file before the namelist reads: every `&group` must be known, and every `key =`
+  !> inside it must be one of the group's keys. (The namelist reader would skip unknown groups,
+  !> and may report an unknown key as a bad value of the previous array key.)
   subroutine check_groups(path, text, emsg)
     character(len=*), intent(in) :: path, text
     character(len=:), allocatable, intent(inout) :: emsg
-    integer :: i, j, lineno
-    character(len=:), allocatable :: name
-    lineno = 1
+    character(len=*), parameter :: IDCHARS = 'abcdefghijklmnopqrstuvwxyz_0123456789'
+    integer :: i, j, k, lineno, n
+    character(len=:), allocatable :: group, keys, key
+    character(len=1) :: c, quote
+    n = len(text)
+    lineno = 1; group = ''; quote = ' '
     i = 1
-    do while (i <= len(text))
-      if (text(i:i) == new_line('a')) lineno = lineno + 1
-      if (text(i:i) == '!') then
-        ! Skip comments to the end of the line.
-        do while (i < len(text))
+    do while (i <= n)
+      c = text(i:i)
+      if (c == new_line('a')) lineno = lineno + 1
+      if (quote /= ' ') then
+        if (c == quote) quote = ' '
+      else if (c == '''' .or. c == '"') then
+        quote = c
+      else if (c == '!') then
+        do while (i < n)
           if (text(i + 1:i + 1) == new_line('a')) exit
           i = i + 1
         end do
-      else if (text(i:i) == '&') then
+      else if (c == '&') then
         j = i + 1
-        do while (j <= len(text))
-          if (index('abcdefghijklmnopqrstuvwxyz_0123456789', lower(text(j:j))) == 0) exit
+        do while (j <= n)
+          if (index(IDCHARS, lower(text(j:j))) == 0) exit
           j = j + 1
         end do
-        name = lower(text(i + 1:j - 1))
-        if (len(name) > 0) then
-          if (index(' '//GROUPS//' ', ' '//name//' ') == 0) then
-            emsg = path//':'//str(lineno)//': unknown group &'//name//'; expected one of: '// &
+        group = lower(text(i + 1:j - 1))
+        if (len(group) > 0) then
+          if (len(group_keys(group)) == 0) then
+            emsg = path//':'//str(lineno)//': unknown group &'//group//'; expected one of: '// &
               GROUPS
             return
           end if
         end if
+        i = j - 1
+      else if (c == '/' .and. len(group) > 0) then
+        group = ''
+      else if (len(group) > 0 .and. index(IDCHARS, lower(c)) > 0 .and. &
+               index('0123456789', c) == 0) then
+        ! An identifier inside a group: a key if followed by '=' (optionally after "(...)").
+        j = i
+        do while (j <= n)
+          if (index(IDCHARS, lower(text(j:j))) == 0) exit
+          j = j + 1
+        end do
+        key = lower(text(i:j - 1))
+        k = skip_blanks(j)
+        if (k <= n) then
+          if (text(k:k) == '(') k = skip_blanks(index(text(k:), ')') + k)
+        end if
+        if (k <= n) then
+          if (text(k:k) == '=') then
+            keys = group_keys(group)
+            if (index(' '//keys//' ', ' '//key//' ') == 0) then
+              emsg = path//':'//str(lineno)//': group &'//group//': unknown key '''//key// &
+                '''; valid keys: '//keys
+              return
+            end if
+          end if
+        end if
+        i = j - 1
       end if
       i = i + 1
     end do
+  contains
+    pure integer function skip_blanks(from) result(pos)
+      integer, intent(in) :: from
+      pos = from
+      do while (pos <= n)
+        if (text(pos:pos) /= ' ') exit
+        pos = pos + 1
+      end do
+    end function skip_blanks
   end subroutine check_groups
 
   !> Message for a failed namelist read (unknown key or malformed value).

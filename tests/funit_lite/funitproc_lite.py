@@ -169,20 +169,22 @@ def expand_assertion(path, lines, d, out_name):
     """Output lines for directive `d`; usually as many as it spans in the .pf."""
     lineno = d.first + 1
     out = list(lines[d.first:d.last + 1])
-    last = out[-1]
-    before = last[:d.close_col].rstrip()
+    # `@assertX` becomes `call assertX` on the first line
+    m = RE_DIRECTIVE.match(out[0])
+    head = m.group(1) + "call " + d.name
+    close_col = d.close_col
+    if d.last == d.first:
+        close_col += len(head) - (len(m.group(1)) + 1 + len(m.group(2)))
+    out[0] = head + m.group(3)
+    # the location goes before the closing ')', then the early return
+    before = out[-1][:close_col].rstrip()
     tail = ", location=SourceLocation('%s', %d)); if (anyExceptions()) return" % (
         out_name, lineno)
     if len(before) + len(tail) <= MAX_COLUMNS:
         out[-1] = before + tail
     else:
-        indent = re.match(r"\s*", lines[d.first]).group(0)
         out[-1] = before + " &"
-        out.append(indent + "  & " + tail)
-    # replace `@assertX` with `call assertX` on the first line
-    m = RE_DIRECTIVE.match(out[0])
-    indent, rest = m.group(1), m.group(3)
-    out[0] = indent + "call " + d.name + rest
+        out.append(m.group(1) + "  & " + tail)
     for k, text in enumerate(out):
         if len(text) > MAX_COLUMNS:
             stripped = text.lstrip()
@@ -436,10 +438,10 @@ def main(argv=None):
             driver(args.output, args.modules, args.extra_use, args.extra_initialize,
                    args.extra_finalize)
     except PfError as e:
-        print("funit-lite: error: %s" % e, file=sys.stderr)
+        print(e, file=sys.stderr)
         return 1
     except OSError as e:
-        print("funit-lite: error: %s" % e, file=sys.stderr)
+        print(e, file=sys.stderr)
         return 1
     return 0
 
