@@ -7,10 +7,11 @@ module empm_integrator
   use empm_kinds, only: wp
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_SHAPE_FAILED, &
                         STEP_MATERIAL_FAILED
-  use empm_transfer, only: p2g_internal_force, p2g_body_force, constrain_force
+  use empm_transfer, only: p2g_mass, p2g_internal_force, p2g_body_force, constrain_force, &
+                           nodal_divide_by_mass, g2p_value
   implicit none
   private
-  public :: empm_integrator_t, eval_basis, update_stress
+  public :: empm_integrator_t, eval_basis, update_stress, initial_acceleration
 
   !> Abstract explicit integrator. Work arrays are allocated once in `prepare`.
   type, abstract :: empm_integrator_t
@@ -19,6 +20,7 @@ module empm_integrator
     procedure(step_iface), deferred :: step
     procedure(name_iface), deferred :: name
     procedure :: prepare => integrator_prepare
+    procedure :: start => integrator_start
     procedure :: assemble_forces
   end type empm_integrator_t
 
@@ -42,14 +44,40 @@ module empm_integrator
 
 contains
 
-  !> Allocate work arrays for `model` (call once, after the model's set-up, before stepping).
+  !> Allocate work arrays for `model` and initialise the scheme's state (`start`). Call once,
+  !> after the model's set-up, before stepping ([[empm_solve]] does).
   subroutine integrator_prepare(self, model)
     class(empm_integrator_t), intent(inout) :: self !! integrator
-    type(empm_model_t), intent(in) :: model         !! simulation state
+    type(empm_model_t), intent(inout) :: model      !! simulation state
     if (allocated(self%bwork)) deallocate(self%bwork)
     allocate(self%bwork(model%grid%ndim, model%pts%np))
     self%bwork = 0.0_wp
+    call self%start(model)
   end subroutine integrator_prepare
+
+  !> Scheme-specific initialisation hook; the default does nothing.
+  subroutine integrator_start(self, model)
+    class(empm_integrator_t), intent(inout) :: self !! integrator
+    type(empm_model_t), intent(inout) :: model      !! simulation state
+    associate (unused_self => self, unused_model => model)
+    end associate
+  end subroutine integrator_start
+
+  !> Particle accelerations consistent with the initial state, a_p = Σ N_Ip f_I/m_I at the
+  !> current time, for schemes that carry a_p between steps (predictor-corrector,
+  !> generalized-α). A shape failure is left for the first step to report.
+  subroutine initial_acceleration(self, model)
+    class(empm_integrator_t), intent(inout) :: self !! integrator (body-force scratch)
+    type(empm_model_t), intent(inout) :: model      !! simulation state
+    type(empm_step_status_t) :: stat
+    call eval_basis(model, stat)
+    if (stat%code /= 0) return
+    call model%nodes%reset()
+    call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
+    call self%assemble_forces(model, model%t)
+    call nodal_divide_by_mass(model%nodes, model%nodes%force, model%nodes%acc)
+    call g2p_value(model%basis, model%nodes%acc, model%pts%a)
+  end subroutine initial_acceleration
 
   !> Evaluate shape functions at the current particle positions (one batched call).
   subroutine eval_basis(model, stat)

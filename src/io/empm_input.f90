@@ -87,7 +87,7 @@ contains
     case ('particles'); keys = 'material geometry lo hi center radius ppc placement velocity '// &
       'velocity_sine_amplitude velocity_sine_wavenumber velocity_sine_phase stress'
     case ('shape'); keys = 'family'
-    case ('integrator'); keys = 'scheme cfl dt t_end max_steps'
+    case ('integrator'); keys = 'scheme cfl dt t_end max_steps newmark_gamma rho_b'
     case ('loads'); keys = 'gravity ramp ramp_time'
     case ('boundary'); keys = 'lo hi fix velocity'
     case ('probe'); keys = 'name particle point'
@@ -412,13 +412,14 @@ contains
     character(len=*), intent(in) :: path
     type(empm_case_t), intent(inout) :: cs
     character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'scheme, cfl, dt, t_end, max_steps'
+    character(len=*), parameter :: K = 'scheme, cfl, dt, t_end, max_steps, newmark_gamma, rho_b'
     character(len=64) :: scheme
-    real(wp) :: cfl, dt, t_end
+    real(wp) :: cfl, dt, t_end, newmark_gamma, rho_b
     integer :: max_steps, ios, info
     character(len=512) :: msg
-    namelist /integrator/ scheme, cfl, dt, t_end, max_steps
+    namelist /integrator/ scheme, cfl, dt, t_end, max_steps, newmark_gamma, rho_b
     scheme = 'musl'; cfl = 0.5_wp; dt = 0.0_wp; t_end = UNSET; max_steps = 100000000
+    newmark_gamma = 0.5_wp; rho_b = 0.8_wp
     rewind(u)
     read(u, nml=integrator, iostat=ios, iomsg=msg)
     if (ios == iostat_end) then
@@ -426,7 +427,14 @@ contains
     else if (ios /= 0) then
       emsg = nml_error(path, 'integrator', K, msg); return
     end if
-    call empm_integrator_create(trim(lower(scheme)), cs%integ, info)
+    if (.not. (newmark_gamma >= 0.0_wp .and. newmark_gamma <= 1.0_wp)) then
+      emsg = req(path, 'integrator', 'newmark_gamma', 'expected 0 <= newmark_gamma <= 1, got '// &
+        str(newmark_gamma)); return
+    end if
+    if (.not. (rho_b >= 0.0_wp .and. rho_b <= 1.0_wp)) then
+      emsg = req(path, 'integrator', 'rho_b', 'expected 0 <= rho_b <= 1, got '//str(rho_b)); return
+    end if
+    call empm_integrator_create(trim(lower(scheme)), cs%integ, info, newmark_gamma, rho_b)
     if (info /= 0) then
       emsg = req(path, 'integrator', 'scheme', 'unknown scheme '''//trim(scheme)// &
         '''; expected one of: '//empm_integrator_names()); return

@@ -26,7 +26,7 @@ module funit
 
   integer, parameter :: MAXLEN_FILE_NAME = 255   !! as pFUnit's SourceLocation
   integer, parameter :: MAXLEN_MESSAGE = 2048    !! longer failure messages are truncated
-  integer, parameter :: LEN_REAL = 24            !! es24.16
+  integer, parameter :: LEN_REAL = 32            !! es24.16 or es25.16e3
   integer, parameter :: LEN_INT = 24
 
   !> Where an assertion sits in its .pf file (same components as pFUnit's type, so the
@@ -209,13 +209,23 @@ contains
 
   ! ================================================================== formatting ====
 
-  !> A real64 in es24.16, without blanks (NaN and Infinity as the compiler writes them).
+  !> A real64 in es24.16 (es25.16e3 for exponents beyond two digits), without blanks;
+  !> NaN and Infinity as the compiler writes them.
   function real_str(x) result(s)
     real(real64), intent(in) :: x
     character(len=:), allocatable :: s
     character(len=LEN_REAL) :: buf
 
-    write(buf, '(es24.16)') x
+    buf = ''
+    if (ieee_is_finite(x)) then
+      if (x /= 0.0_real64 .and. (abs(x) >= 1.0e99_real64 .or. abs(x) < 1.0e-99_real64)) then
+        write(buf, '(es25.16e3)') x
+      else
+        write(buf, '(es24.16)') x
+      end if
+    else
+      write(buf, '(es24.16)') x
+    end if
     s = trim(adjustl(buf))
   end function real_str
 
@@ -350,16 +360,16 @@ contains
     character(len=*), optional, intent(in) :: message
     type(SourceLocation), optional, intent(in) :: location
     real(real64) :: d, d_first, d_max
-    logical :: finite, finite_first, all_finite
-    integer :: i, first, n_bad
+    logical :: finite, finite_first
+    integer :: i, first, n_bad, n_bad_finite
     character(len=:), allocatable :: text
 
     n_bad = 0
+    n_bad_finite = 0
     first = 0
     d_first = 0.0_real64
     d_max = 0.0_real64
     finite_first = .true.
-    all_finite = .true.
     do i = 1, size(a)
       if (reals_match(e(i), a(i), tol, d, finite)) cycle
       n_bad = n_bad + 1
@@ -369,9 +379,8 @@ contains
         finite_first = finite
       end if
       if (finite) then
+        n_bad_finite = n_bad_finite + 1
         d_max = max(d_max, d)
-      else
-        all_finite = .false.
       end if
     end do
     if (n_bad == 0) return
@@ -382,9 +391,9 @@ contains
       text = text // '; difference ' // real_str(d_first) // ' > tolerance ' // real_str(tol)
     end if
     if (size(shp) > 0) then
-      if (all_finite) then
+      if (n_bad_finite == n_bad) then
         text = text // '; max difference ' // real_str(d_max)
-      else
+      else if (n_bad_finite > 0) then
         text = text // '; max difference over finite elements ' // real_str(d_max)
       end if
       text = text // ' (' // int_str(n_bad) // ' of ' // int_str(size(a)) // &

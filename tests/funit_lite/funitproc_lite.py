@@ -24,7 +24,12 @@ Supported .pf subset (anything else starting with `@` is an error):
     `@assertRelativelyEqual`, `@assertIsFinite`, each `@assertX(args)` on its own line
     (continued over several lines with `&` if needed), expanded as pFUnit does to
     `call assertX(args, location=SourceLocation('file.pf', LINE))` followed by
-    `if (anyExceptions()) return`, where LINE is the line of the `@`.
+    `if (anyExceptions()) return`, where LINE is the line of the `@`;
+  * a directive line holds nothing else (no trailing comment), as pFUnit requires;
+  * the module must `use funit`.
+
+Errors are reported on stderr as `file.pf:LINE: message` (exit status 1), e.g.
+`file.pf:12: unsupported pFUnit directive @assertNotEqual (funit-lite supports: ...)`.
 
 Line numbers: the output keeps the .pf line numbering (line N of the .F90 is line N of
 the .pf) as long as the expansions fit in the 132-column limit; an expansion that needs
@@ -59,6 +64,8 @@ RE_MODULE = re.compile(r"^\s*module\s+(\w+)\s*(!.*)?$", re.IGNORECASE)
 RE_SUBROUTINE = re.compile(
     r"^\s*subroutine\s+(\w+)\s*(\((?P<args>[^)]*)\))?\s*(!.*)?$", re.IGNORECASE)
 RE_BLANK_OR_COMMENT = re.compile(r"^\s*(!.*)?$")
+RE_USE_FUNIT = re.compile(
+    r"^\s*use\s*(,\s*non_intrinsic\s*::\s*|::\s*|\s)\s*funit\s*(,.*)?(!.*)?$", re.IGNORECASE)
 
 
 class PfError(Exception):
@@ -295,6 +302,8 @@ def process(in_path, out_path):
         fail(in_path, 1, "no 'module <name>' statement found")
     if not tests:
         fail(in_path, 1, "no @test procedures found")
+    if not any(RE_USE_FUNIT.match(line) for line in lines):
+        fail(in_path, 1, "module %s does not 'use funit'" % module)
     for name in ("wrap_" + module, module + "_suite"):
         if len(name) > MAX_NAME:
             fail(in_path, 1, "module name too long for the generated name %s" % name)
