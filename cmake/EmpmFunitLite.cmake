@@ -15,7 +15,8 @@
 # ignored, as is REGISTRY (the suites are always <basename>_suite, as with pFUnit's default).
 #
 # Also defines empm_funit_lite_selftest(), which registers the runner's own failure-reporting
-# checks, and calls it when EMPM_BUILD_TESTS is on.
+# checks and checks that the preprocessor rejects what pFUnit 4.x cannot build, and calls it
+# when EMPM_BUILD_TESTS is on.
 
 include_guard(GLOBAL)
 
@@ -110,6 +111,22 @@ function(add_pfunit_ctest test_package_name)
            WORKING_DIRECTORY ${workdir})
 endfunction()
 
+# funit_lite_rejects_<case>: preprocessing tests/funit_lite/selftest/rejected_<case>.pf fails;
+# funit_lite_rejects_<case>_message: its error message matches <regex>.
+function(_empm_funit_lite_rejects case regex)
+  set(script ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/../tests/funit_lite/funitproc_lite.py)
+  get_filename_component(script ${script} ABSOLUTE)
+  set(pf ${CMAKE_CURRENT_FUNCTION_LIST_DIR}/../tests/funit_lite/selftest/rejected_${case}.pf)
+  get_filename_component(pf ${pf} ABSOLUTE)
+  set(out ${CMAKE_CURRENT_BINARY_DIR}/funit_lite/rejected/rejected_${case}.F90)
+  foreach(test IN ITEMS funit_lite_rejects_${case} funit_lite_rejects_${case}_message)
+    add_test(NAME ${test} COMMAND ${Python3_EXECUTABLE} ${script} process ${pf} ${out})
+  endforeach()
+  set_tests_properties(funit_lite_rejects_${case} PROPERTIES WILL_FAIL TRUE LABELS funit-lite)
+  set_tests_properties(funit_lite_rejects_${case}_message PROPERTIES
+    PASS_REGULAR_EXPRESSION "${regex}" LABELS funit-lite)
+endfunction()
+
 # The runner's own checks, funit-lite mode only: tests/funit_lite/selftest/failing_example.pf
 # must fail (non-zero exit) and must report file, line, test, expected and actual values.
 function(empm_funit_lite_selftest)
@@ -127,7 +144,7 @@ function(empm_funit_lite_selftest)
     "> tolerance 1\\.2500000000000000E-01\n"
     "failing_example\\.pf:25: test_array_mismatch: at index \\(3\\) of shape \\(4\\): "
     "expected 2\\.0000000000000000E\\+00 but found 2\\.5000000000000000E\\+00[^\n]*\n"
-    "failing_example\\.pf:30: test_message_and_continuation: nodes: expected 7 but found 8\n"
+    "failing_example\\.pf:30: test_message: nodes: expected 7 but found 8\n"
     "failing_example\\.pf:36: test_stops_at_first_failure: expected \\.true\\. but found "
     "\\.false\\.\n"
     "1 passed, 5 failed\n")
@@ -137,6 +154,15 @@ function(empm_funit_lite_selftest)
     PASS_REGULAR_EXPRESSION "${expected_output}"
     FAIL_REGULAR_EXPRESSION "failing_example\\.pf:37:|not reached"
     LABELS funit-lite)
+
+  # Constructs pFUnit 4.x cannot build must be rejected by the preprocessor (non-zero exit),
+  # with a message naming the file and line: rejected_<case>.pf, see docs/testing.md.
+  _empm_funit_lite_rejects(continuation
+    "rejected_continuation\\.pf:10: pFUnit 4\\.x requires @assertEqual on one line \\(no '&' continuation\\)")
+  _empm_funit_lite_rejects(long_line
+    "rejected_long_line\\.pf:11: directive line is 129 columns long, the limit is 128")
+  _empm_funit_lite_rejects(module_comment
+    "rejected_module_comment\\.pf:1: comment on the 'module' line")
 endfunction()
 
 if(EMPM_BUILD_TESTS)

@@ -21,11 +21,14 @@ Supported .pf subset (anything else starting with `@` is an error):
   * `@before` / `@after`, followed by `subroutine <name>()`: run around every test;
   * `@assertEqual`, `@assertTrue`, `@assertFalse`, `@assertLessThan`,
     `@assertLessThanOrEqual`, `@assertGreaterThan`, `@assertGreaterThanOrEqual`,
-    `@assertRelativelyEqual`, `@assertIsFinite`, each `@assertX(args)` on its own line
-    (continued over several lines with `&` if needed), expanded as pFUnit does to
+    `@assertRelativelyEqual`, `@assertIsFinite`, each `@assertX(args)` alone on one
+    line, expanded as pFUnit does to
     `call assertX(args, location=SourceLocation('file.pf', LINE))` followed by
     `if (anyExceptions()) return`, where LINE is the line of the `@`;
-  * a directive line holds nothing else (no trailing comment), as pFUnit requires;
+  * as pFUnit 4.x requires: no `&` continuation of a directive, directive lines of at most
+    128 columns (pFUnit writes `call ` in place of `@`; the result must fit in 132 columns),
+    nothing else on a directive line (no trailing comment) and no comment on the `module`
+    line;
   * the module must `use funit`.
 
 Errors are reported on stderr as `file.pf:LINE: message` (exit status 1), e.g.
@@ -57,6 +60,11 @@ ASSERTIONS = [
 CANONICAL = {name.lower(): name for name in ASSERTIONS}
 SUPPORTED = ["@test", "@before", "@after"] + ["@" + name for name in ASSERTIONS]
 MAX_COLUMNS = 132   # Fortran 2008 free-form line length
+# pFUnit 4.x writes `@assertX(args)` as `call assertX(args, &`: `call ` in place of `@`.
+# For the result to fit in 132 columns (gfortran rejects longer free-form lines), a
+# directive line may have at most 128 columns (trailing blanks not counted).
+MAX_DIRECTIVE_COLUMNS = MAX_COLUMNS - len("call ") + len("@")
+CONTINUATION_MESSAGE = "pFUnit 4.x requires @%s on one line (no '&' continuation)"
 MAX_NAME = 63       # Fortran 2008 name length
 
 RE_DIRECTIVE = re.compile(r"^(\s*)@(\w*)(.*)$")
@@ -81,7 +89,7 @@ def fail(path, lineno, message):
 
 
 class Directive:
-    """An `@assertX(...)` spanning physical lines first..last (0-based indices)."""
+    """An `@assertX(...)` on lines[first] (0-based); `last` == `first` (no continuation)."""
 
     def __init__(self, name, first, last, close_col):
         self.name = name            # canonical assertion name
@@ -91,85 +99,64 @@ class Directive:
 
 
 def scan_assertion(path, lines, first, name_end, name):
-    """Find the argument list of the assertion `@name(...)` that starts on lines[first].
+    """Find the argument list of the assertion `@name(...)` on lines[first].
 
-    `name_end` is the column just after the directive name.  Handles character
-    literals, `!` comments, `&` continuation (with optional leading `&` on the next
-    line) and comment or blank lines between continued lines, as Fortran does.
-    Returns (last_line_index, close_column).
+    `name_end` is the column just after the directive name.  pFUnit 4.x only expands an
+    assertion whose line matches `@assertX(...)` ending in `)`, so the whole directive must
+    be on one line: a `&` continuation (in the arguments or in a character literal) is an
+    error, as is anything after the closing `)`.  Character literals are skipped, so
+    parentheses, `&` and `!` inside them do not count.  Returns (first, close_column).
     """
     lineno = first + 1
+    line = lines[first]
     depth = 0           # parenthesis depth; 0 before the opening '('
     quote = None        # delimiter of the character literal being scanned
     opened = False
     has_args = False
-    i = first
     col = name_end
-    while True:
-        line = lines[i]
-        continued = False
-        while col < len(line):
-            ch = line[col]
-            if quote:
-                if ch == quote:
-                    if line[col + 1:col + 2] == quote:
-                        col += 1          # doubled delimiter inside the literal
-                    else:
-                        quote = None
-                elif ch == "&" and line[col + 1:].strip() == "":
-                    continued = True      # the literal continues on the next line
-                    break
-            elif ch.isspace():
-                pass
-            elif ch == "!":
-                break                     # comment to the end of the line
-            elif ch == "&":
-                rest = line[col + 1:].strip()
-                if rest and not rest.startswith("!"):
-                    fail(path, i + 1, "unexpected '&' in @%s" % name)
-                continued = True
-                break
-            elif not opened:
-                if ch != "(":
-                    fail(path, lineno, "expected '(' after @%s" % name)
-                opened = True
-                depth = 1
-            else:
-                if ch in "'\"":
-                    quote = ch
-                elif ch == "(":
-                    depth += 1
-                elif ch == ")":
-                    depth -= 1
-                    if depth == 0:
-                        rest = line[col + 1:].strip()
-                        if rest:
-                            fail(path, i + 1,
-                                 "unexpected text after the closing ')' of @%s: %r (pFUnit "
-                                 "rejects it too; put comments on their own line)"
-                                 % (name, rest))
-                        if not has_args:
-                            fail(path, lineno, "@%s without arguments" % name)
-                        return i, col
-                has_args = True
-            col += 1
-        if not continued:
-            if quote:
-                fail(path, i + 1, "unterminated character literal in @%s" % name)
-            fail(path, lineno, "@%s is missing its closing ')' (continue long assertions "
-                 "with '&' at the end of the line)" % name)
-        # next physical line that is not blank or a comment
-        i += 1
-        while i < len(lines) and not quote and RE_BLANK_OR_COMMENT.match(lines[i]):
-            i += 1
-        if i >= len(lines):
-            fail(path, lineno, "@%s continues past the end of the file" % name)
-        stripped = lines[i].lstrip()
-        col = len(lines[i]) - len(stripped)
-        if stripped.startswith("&"):
-            col += 1
-        elif quote:
-            col = 0   # character context without a leading '&': continues at column 1
+    while col < len(line):
+        ch = line[col]
+        if quote:
+            if ch == quote:
+                if line[col + 1:col + 2] == quote:
+                    col += 1          # doubled delimiter inside the literal
+                else:
+                    quote = None
+            elif ch == "&" and line[col + 1:].strip() == "":
+                fail(path, lineno, CONTINUATION_MESSAGE % name)
+        elif ch.isspace():
+            pass
+        elif ch == "&":
+            fail(path, lineno, CONTINUATION_MESSAGE % name)
+        elif ch == "!":
+            break                     # a comment before the closing ')'
+        elif not opened:
+            if ch != "(":
+                fail(path, lineno, "expected '(' after @%s" % name)
+            opened = True
+            depth = 1
+        else:
+            if ch in "'\"":
+                quote = ch
+            elif ch == "(":
+                depth += 1
+            elif ch == ")":
+                depth -= 1
+                if depth == 0:
+                    rest = line[col + 1:].strip()
+                    if rest:
+                        fail(path, lineno,
+                             "unexpected text after the closing ')' of @%s: %r (pFUnit "
+                             "rejects it too; put comments on their own line)" % (name, rest))
+                    if not has_args:
+                        fail(path, lineno, "@%s without arguments" % name)
+                    return first, col
+            has_args = True
+        col += 1
+    if quote:
+        fail(path, lineno, "unterminated character literal in @%s" % name)
+    fail(path, lineno, "@%s is missing its closing ')' (pFUnit 4.x requires the whole "
+         "assertion on one line)" % name)
 
 
 def expand_assertion(path, lines, d, out_name):
@@ -199,8 +186,8 @@ def expand_assertion(path, lines, d, out_name):
                 out[k] = " " + stripped
             else:
                 fail(path, lineno,
-                     "line longer than %d columns after expansion; split the assertion "
-                     "with '&'" % MAX_COLUMNS)
+                     "line longer than %d columns after expansion; shorten the assertion"
+                     % MAX_COLUMNS)
     return out
 
 
@@ -246,6 +233,12 @@ def process(in_path, out_path):
 
         dm = RE_DIRECTIVE.match(line)
         if dm:
+            width = len(line.rstrip())
+            if width > MAX_DIRECTIVE_COLUMNS:
+                fail(in_path, lineno, "directive line is %d columns long, the limit is %d: "
+                     "pFUnit 4.x writes it with 'call ' in place of '@' and the result must "
+                     "fit in %d columns (shorten it, e.g. with a local variable)"
+                     % (width, MAX_DIRECTIVE_COLUMNS, MAX_COLUMNS))
             if pending is not None:
                 fail(in_path, lineno, "directive @%s where the subroutine of @%s (line %d) "
                      "was expected" % (dm.group(2), pending[0], pending[1]))
@@ -282,6 +275,10 @@ def process(in_path, out_path):
 
         mm = RE_MODULE.match(line)
         if mm and mm.group(1).lower() != "procedure":
+            if mm.group(2):
+                fail(in_path, lineno, "comment on the 'module' line: pFUnit 4.x then does not "
+                     "recognise the module and the tests fail to link; put the comment on "
+                     "its own line")
             if module is not None:
                 fail(in_path, lineno, "more than one module in a .pf file (funit-lite "
                      "expects exactly one)")
