@@ -9,11 +9,11 @@ module empm_solver
   use empm_integrator, only: empm_integrator_t
   use empm_particles, only: empm_particles_t
   use empm_history, only: empm_history_t
-  use empm_shape, only: shape_status_text
+  use empm_shape, only: shape_status_text, SHAPE_OUTSIDE_GRID
   use empm_terminal, only: stderr_is_terminal
   implicit none
   private
-  public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
+  public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies, empm_check_guards
 
   !> How to run: end time, time step control, output sampling.
   type :: empm_run_config_t
@@ -133,7 +133,7 @@ contains
         call restore(); call fail(msg); return
       end if
       model%t = model%t + dt
-      msg = check_guards(model)
+      msg = empm_check_guards(model)
       if (len(msg) > 0) then
         call restore(); call fail(msg); return
       end if
@@ -191,7 +191,7 @@ contains
       if (s%code == STEP_SHAPE_FAILED) then
         text = 'step '//str(model%step)//': shape functions failed at particle '// &
           str(s%particle)//' at x = '//vec(model%pts%x(:, p))//': '//shape_status_text(s%detail)
-        if (s%detail == 1) text = 'step '//str(model%step)//': particle '//str(s%particle)// &
+        if (s%detail == SHAPE_OUTSIDE_GRID) text = 'step '//str(model%step)//': particle '//str(s%particle)// &
           ' left the grid: x = '//vec(model%pts%x(:, p))
       else
         text = 'step '//str(model%step)//': stress update failed at particle '// &
@@ -203,7 +203,7 @@ contains
 
   !> Check particle and nodal fields after a step; returns '' when all is well, otherwise a
   !> message naming the step, the particle or node and the quantity.
-  function check_guards(model) result(msg)
+  function empm_check_guards(model) result(msg)
     type(empm_model_t), intent(in) :: model !! simulation state
     character(len=:), allocatable :: msg    !! '' or the first problem found
     integer :: p, I
@@ -236,7 +236,7 @@ contains
         return
       end if
     end do
-  end function check_guards
+  end function empm_check_guards
 
   pure function vec(x) result(s)
     real(wp), intent(in) :: x(:)
