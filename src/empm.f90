@@ -18,7 +18,7 @@ module empm
   use empm_shape_factory, only: empm_shape_create, empm_shape_names
   use empm_material, only: empm_material_t
   use empm_material_factory, only: empm_material_create, material_status_text
-  use empm_loads, only: empm_loads_t, empm_body_force_cb, RAMP_NONE, RAMP_SINE
+  use empm_loads, only: empm_loads_t, empm_body_force_t, RAMP_NONE, RAMP_SINE
   use empm_model, only: empm_model_t, empm_material_slot_t, empm_step_status_t, STEP_OK
   use empm_integrator, only: empm_integrator_t
   use empm_integrator_factory, only: empm_integrator_create, empm_integrator_names
@@ -42,7 +42,7 @@ module empm
   public :: empm_shape_create, empm_shape_names
   ! Materials and loads
   public :: empm_material_t, empm_material_create, material_status_text
-  public :: empm_loads_t, empm_body_force_cb, RAMP_NONE, RAMP_SINE
+  public :: empm_loads_t, empm_body_force_t, RAMP_NONE, RAMP_SINE
   ! Model, integrators, solver, output
   public :: empm_model_t, empm_material_slot_t, empm_step_status_t, STEP_OK
   public :: empm_integrator_t, empm_integrator_create, empm_integrator_names

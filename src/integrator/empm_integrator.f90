@@ -102,8 +102,8 @@ contains
     model%nodes%force = 0.0_wp
     call p2g_internal_force(model%basis, model%pts%vol, model%pts%stress, model%nodes%force)
     g = model%loads%gravity_at(t)
-    if (associated(model%loads%body_force)) then
-      call model%loads%body_force(t, model%pts%x0(:, 1:np), model%pts%x(:, 1:np), &
+    if (allocated(model%loads%body_force)) then
+      call model%loads%body_force%eval(t, model%pts%x0(:, 1:np), model%pts%x(:, 1:np), &
                                   self%bwork(:, 1:np))
       call p2g_body_force(model%basis, model%pts%m, g(1:d), self%bwork, .true., &
                           model%nodes%force)

@@ -1,23 +1,33 @@
-!> External loads: gravity (constant or with the paper's sinusoidal ramp, eq. 46) and a
-!> user body-force callback (used by manufactured solutions).
+!> External loads: gravity (constant or with the paper's sinusoidal ramp, eq. 46) and an
+!> optional user body force (used by manufactured solutions).
+!>
+!> The body force is an object extending [[empm_body_force_t]], so that it can carry its own
+!> parameters (no global state); it is evaluated once per step for all particles.
 module empm_loads
   use empm_kinds, only: wp, pi
   implicit none
   private
-  public :: empm_loads_t, empm_body_force_cb, RAMP_NONE, RAMP_SINE
+  public :: empm_loads_t, empm_body_force_t, RAMP_NONE, RAMP_SINE
 
   integer, parameter :: RAMP_NONE = 0 !! gravity constant in time
   integer, parameter :: RAMP_SINE = 1 !! paper eq. (46): sinusoidal rise to t_ramp/2, then constant
 
+  !> A user body force per unit mass, b(X, x, t).
+  type, abstract :: empm_body_force_t
+  contains
+    procedure(body_force_iface), deferred :: eval
+  end type empm_body_force_t
+
   abstract interface
-    !> Body force per unit mass at `n` particles, added to gravity.
-    subroutine empm_body_force_cb(t, x0, x, b)
-      import :: wp
+    !> Body force per unit mass at `n` particles (added to gravity).
+    subroutine body_force_iface(self, t, x0, x, b)
+      import :: empm_body_force_t, wp
+      class(empm_body_force_t), intent(in) :: self !! body-force object
       real(wp), intent(in) :: t          !! time [s]
       real(wp), intent(in) :: x0(:,:)    !! reference positions (ndim, n) [m]
       real(wp), intent(in) :: x(:,:)     !! current positions (ndim, n) [m]
       real(wp), intent(out) :: b(:,:)    !! body force per unit mass (ndim, n) [m/s²]
-    end subroutine empm_body_force_cb
+    end subroutine body_force_iface
   end interface
 
   !> Load definition of a model.
@@ -25,7 +35,7 @@ module empm_loads
     real(wp) :: gravity(3) = 0.0_wp                 !! final gravity vector [m/s²]
     integer :: ramp = RAMP_NONE                     !! RAMP_NONE or RAMP_SINE
     real(wp) :: t_ramp = 0.0_wp                     !! ramp period T of eq. (46) [s]
-    procedure(empm_body_force_cb), pointer, nopass :: body_force => null() !! optional callback
+    class(empm_body_force_t), allocatable :: body_force !! optional user body force
   contains
     procedure :: gravity_at => loads_gravity_at
   end type empm_loads_t
