@@ -3,9 +3,13 @@ program empm_main
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use empm, only: empm_version, empm_run_case, empm_error_t
   use empm_terminal, only: empm_exit
+  use empm_files, only: empm_mkdir_p
+  use empm_verify_suite, only: empm_verify_run
   implicit none
-  integer :: nargs, i, ios
-  character(len=:), allocatable :: cmd, case_file, out_file, written
+  integer :: nargs, i, ios, nfail, npat
+  character(len=:), allocatable :: cmd, case_file, out_file, written, manifest, outdir
+  character(len=256), allocatable :: patterns(:)
+  logical :: quick
   type(empm_error_t) :: err
 
   nargs = command_argument_count()
@@ -40,6 +44,35 @@ program empm_main
       call empm_exit(err%code)
     end if
     write(output_unit, '(a)', iostat=ios) 'empm: wrote '//written
+  case ('verify')
+    manifest = 'verification/cases.txt'; outdir = 'reports'; quick = .false.
+    allocate(patterns(nargs)); npat = 0
+    i = 2
+    do while (i <= nargs)
+      select case (arg(i))
+      case ('--quick')
+        quick = .true.; i = i + 1
+      case ('--out', '-o')
+        if (i == nargs) call die('option '//arg(i)//' needs a folder')
+        outdir = arg(i + 1); i = i + 2
+      case ('--manifest')
+        if (i == nargs) call die('option '//arg(i)//' needs a file')
+        manifest = arg(i + 1); i = i + 2
+      case default
+        if (index(arg(i), '-') == 1) call die('unknown option '//arg(i))
+        npat = npat + 1; patterns(npat) = arg(i); i = i + 1
+      end select
+    end do
+    if (empm_mkdir_p(outdir//'/raw') /= 0) then
+      write(error_unit, '(a)') 'empm: error: cannot create '//outdir//'/raw'
+      call empm_exit(4)
+    end if
+    call empm_verify_run(manifest, outdir, patterns(1:npat), quick, nfail, err)
+    if (err%code /= 0) then
+      write(error_unit, '(a)') 'empm: error: '//err%message
+      call empm_exit(err%code)
+    end if
+    if (nfail > 0) call empm_exit(5)
   case default
     call die('unknown command '''//cmd//'''')
   end select
@@ -64,13 +97,20 @@ contains
   subroutine usage(u)
     integer, intent(in) :: u
     write(u, '(a)') 'usage: empm run CASE.nml [-o OUT.h5]'
+    write(u, '(a)') '       empm verify [PATTERN...] [--quick] [--out DIR] [--manifest FILE]'
     write(u, '(a)') '       empm --help | --version'
     write(u, '(a)') ''
     write(u, '(a)') 'Runs an explicit MPM simulation described by a namelist case file'
     write(u, '(a)') '(keys: docs/input.md) and writes HDF5 results plus an XDMF file for'
     write(u, '(a)') 'ParaView (layout: docs/output.md).'
     write(u, '(a)') ''
+    write(u, '(a)') 'empm verify runs the verification studies listed in verification/cases.txt'
+    write(u, '(a)') '(or --manifest), only the runs whose id matches a PATTERN (* wildcard, e.g.'
+    write(u, '(a)') '''dyka/*''), writes DIR/raw/*.h5 and DIR/summary.json (default DIR: reports)'
+    write(u, '(a)') 'and exits with status 5 when a check fails. --quick: coarse levels only.'
+    write(u, '(a)') ''
     write(u, '(a)') 'exit status: 0 success, 1 usage error, 2 invalid case file,'
-    write(u, '(a)') '             3 run stopped by a guard (results marked incomplete), 4 I/O error'
+    write(u, '(a)') '             3 run stopped by a guard (results marked incomplete), 4 I/O error,'
+    write(u, '(a)') '             5 a verification check failed'
   end subroutine usage
 end program empm_main

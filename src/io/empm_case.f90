@@ -7,7 +7,18 @@ module empm_case
   use empm_solver, only: empm_run_config_t
   implicit none
   private
-  public :: empm_case_t
+  public :: empm_case_t, empm_overrides_t
+
+  !> Changes applied while reading a case (used by the verification suite to run one case file
+  !> with several shapes, schemes and resolutions). Unset fields leave the file's value.
+  type :: empm_overrides_t
+    integer :: refine = 1                        !! multiply `cells` and divide `h` by this
+    character(len=:), allocatable :: shape       !! shape identifier, e.g. 'linear', 'lme_g0.8'
+    character(len=:), allocatable :: scheme      !! integrator name
+    real(wp) :: cfl = -1.0_wp                    !! Courant number (if > 0)
+    real(wp) :: dt = -1.0_wp                     !! fixed time step (if > 0)
+    real(wp) :: t_end = -1.0_wp                  !! end time (if > 0)
+  end type empm_overrides_t
 
   !> A runnable case.
   type :: empm_case_t

@@ -9,7 +9,7 @@ module empm_input
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_INPUT
   use empm_strings, only: str, lower
-  use empm_case, only: empm_case_t
+  use empm_case, only: empm_case_t, empm_overrides_t
   use empm_model, only: empm_material_slot_t
   use empm_loads, only: RAMP_NONE, RAMP_SINE
   use empm_particle_gen, only: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
@@ -25,20 +25,23 @@ module empm_input
   integer, parameter :: IUNSET = -huge(1)       ! sentinel for required integers
   integer, parameter :: MAXSNAP = 1000          ! capacity of output%snapshot_times
   character(len=*), parameter :: GROUPS = 'grid material particles shape integrator loads '// &
-                                          'boundary probe output'
+                                          'boundary probe output verify'
 
 contains
 
   !> Read, validate and set up the case in `path`. On error, `err` (or a stop with status 2)
   !> names the file, group and key.
-  subroutine empm_read_case(path, cs, err)
+  subroutine empm_read_case(path, cs, err, overrides)
     character(len=*), intent(in) :: path               !! case file
     type(empm_case_t), intent(inout) :: cs             !! the case, ready to run
     type(empm_error_t), intent(out), optional :: err   !! error, if present
+    type(empm_overrides_t), intent(in), optional :: overrides !! changes to the file's values
+    type(empm_overrides_t) :: ov
     integer :: u, ios
     character(len=512) :: msg
     character(len=:), allocatable :: emsg
 
+    if (present(overrides)) ov = overrides
     cs%file = path
     open(newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) then
@@ -47,11 +50,11 @@ contains
     emsg = ''
     call slurp(u, cs%text)
     call check_groups(path, cs%text, emsg)
-    if (len(emsg) == 0) call read_grid(u, path, cs, emsg)
+    if (len(emsg) == 0) call read_grid(u, path, cs, ov, emsg)
     if (len(emsg) == 0) call read_materials(u, path, cs, emsg)
-    if (len(emsg) == 0) call read_shape(u, path, cs, emsg)
+    if (len(emsg) == 0) call read_shape(u, path, cs, ov, emsg)
     if (len(emsg) == 0) call read_particles(u, path, cs, emsg)
-    if (len(emsg) == 0) call read_integrator(u, path, cs, emsg)
+    if (len(emsg) == 0) call read_integrator(u, path, cs, ov, emsg)
     if (len(emsg) == 0) call read_loads(u, path, cs, emsg)
     if (len(emsg) == 0) call read_boundaries(u, path, cs, emsg)
     if (len(emsg) == 0) call read_probes(u, path, cs, emsg)
@@ -92,6 +95,8 @@ contains
     case ('boundary'); keys = 'lo hi fix velocity'
     case ('probe'); keys = 'name particle point'
     case ('output'); keys = 'file history_every snapshot_times'
+    case ('verify'); keys = 'benchmark study shapes schemes levels cfls metrics thresholds '// &
+      'min_order quick_levels quick'
     case default; keys = ''
     end select
   end function group_keys
@@ -191,10 +196,11 @@ contains
 
   ! ---- groups -----------------------------------------------------------------------------
 
-  subroutine read_grid(u, path, cs, emsg)
+  subroutine read_grid(u, path, cs, ov, emsg)
     integer, intent(in) :: u
     character(len=*), intent(in) :: path
     type(empm_case_t), intent(inout) :: cs
+    type(empm_overrides_t), intent(in) :: ov
     character(len=:), allocatable, intent(inout) :: emsg
     character(len=*), parameter :: K = 'ndim, origin, h, cells'
     integer :: ndim, cells(3), ios, info
@@ -229,6 +235,7 @@ contains
     if (any(cells(1:ndim) < 1)) then
       emsg = req(path, 'grid', 'cells', 'expected cell counts >= 1'); return
     end if
+    h = h / ov%refine; cells = cells * ov%refine
     call cs%model%grid%init(ndim, origin, h, cells, info)
     call cs%model%pts%alloc(ndim, 1024)
   end subroutine read_grid
@@ -292,10 +299,11 @@ contains
     if (n == 0) emsg = path//': missing required group &material (keys: '//K//')'
   end subroutine read_materials
 
-  subroutine read_shape(u, path, cs, emsg)
+  subroutine read_shape(u, path, cs, ov, emsg)
     integer, intent(in) :: u
     character(len=*), intent(in) :: path
     type(empm_case_t), intent(inout) :: cs
+    type(empm_overrides_t), intent(in) :: ov
     character(len=:), allocatable, intent(inout) :: emsg
     character(len=*), parameter :: K = 'family'
     character(len=64) :: family
@@ -308,6 +316,7 @@ contains
     if (ios /= 0 .and. ios /= iostat_end) then
       emsg = nml_error(path, 'shape', K, msg); return
     end if
+    if (allocated(ov%shape)) family = ov%shape
     call empm_shape_create(trim(lower(family)), cs%model%grid%ndim, cs%model%shape, info)
     if (info /= 0) then
       emsg = req(path, 'shape', 'family', 'unknown family '''//trim(family)// &
@@ -407,10 +416,11 @@ contains
     if (nbody == 0) emsg = path//': missing required group &particles (keys: '//K//')'
   end subroutine read_particles
 
-  subroutine read_integrator(u, path, cs, emsg)
+  subroutine read_integrator(u, path, cs, ov, emsg)
     integer, intent(in) :: u
     character(len=*), intent(in) :: path
     type(empm_case_t), intent(inout) :: cs
+    type(empm_overrides_t), intent(in) :: ov
     character(len=:), allocatable, intent(inout) :: emsg
     character(len=*), parameter :: K = 'scheme, cfl, dt, t_end, max_steps, newmark_gamma, rho_b'
     character(len=64) :: scheme
@@ -427,6 +437,10 @@ contains
     else if (ios /= 0) then
       emsg = nml_error(path, 'integrator', K, msg); return
     end if
+    if (allocated(ov%scheme)) scheme = ov%scheme
+    if (ov%cfl > 0.0_wp) cfl = ov%cfl
+    if (ov%dt > 0.0_wp) dt = ov%dt
+    if (ov%t_end > 0.0_wp) t_end = ov%t_end
     if (.not. (newmark_gamma >= 0.0_wp .and. newmark_gamma <= 1.0_wp)) then
       emsg = req(path, 'integrator', 'newmark_gamma', 'expected 0 <= newmark_gamma <= 1, got '// &
         str(newmark_gamma)); return

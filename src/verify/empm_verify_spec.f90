@@ -1,0 +1,114 @@
+!> The `&verify` group of a verification case file: which benchmark, which study (a matrix of
+!> shapes × schemes with thresholds, or a convergence study in space or time), the metrics and
+!> their thresholds. Keys are documented in docs/verification.md.
+module empm_verify_spec
+  use, intrinsic :: iso_fortran_env, only: iostat_end
+  use empm_kinds, only: wp
+  use empm_strings, only: str, lower
+  implicit none
+  private
+  public :: empm_verify_spec_t, empm_read_verify_spec, MAXLIST
+
+  integer, parameter :: MAXLIST = 16  !! capacity of each list key
+
+  !> A verification study.
+  type :: empm_verify_spec_t
+    character(len=:), allocatable :: file        !! case file
+    character(len=32) :: benchmark = ''          !! benchmark id (dyka, vibrating_bar, ...)
+    character(len=16) :: study = 'matrix'        !! 'matrix', 'space' or 'time'
+    integer :: nshape = 0, nscheme = 0, nlevel = 0, nmetric = 0
+    character(len=16) :: shapes(MAXLIST) = ''    !! shape identifiers
+    character(len=16) :: schemes(MAXLIST) = ''   !! scheme names
+    integer :: levels(MAXLIST) = 0               !! space study: refinement factors
+    real(wp) :: cfls(MAXLIST) = 0.0_wp           !! time study: Courant numbers
+    character(len=32) :: metrics(MAXLIST) = ''   !! matrix study: metric names
+    real(wp) :: thresholds(MAXLIST) = 0.0_wp     !! matrix study: upper bounds
+    real(wp) :: min_order = 0.0_wp               !! convergence study: required order
+    integer :: quick_levels = 2                  !! convergence levels run in quick mode
+    logical :: quick = .true.                    !! included in the quick subset
+  end type empm_verify_spec_t
+
+contains
+
+  !> Read the `&verify` group of `path`; `emsg` is '' on success.
+  subroutine empm_read_verify_spec(path, spec, emsg)
+    character(len=*), intent(in) :: path                     !! case file
+    type(empm_verify_spec_t), intent(out) :: spec            !! the study
+    character(len=:), allocatable, intent(out) :: emsg       !! '' or the problem
+    character(len=*), parameter :: K = 'benchmark, study, shapes, schemes, levels, cfls, '// &
+      'metrics, thresholds, min_order, quick_levels, quick'
+    character(len=32) :: benchmark, metrics(MAXLIST)
+    character(len=16) :: study, shapes(MAXLIST), schemes(MAXLIST)
+    integer :: levels(MAXLIST), quick_levels, u, ios
+    real(wp) :: cfls(MAXLIST), thresholds(MAXLIST), min_order
+    logical :: quick
+    character(len=512) :: msg
+    namelist /verify/ benchmark, study, shapes, schemes, levels, cfls, metrics, thresholds, &
+      min_order, quick_levels, quick
+    emsg = ''
+    spec%file = path
+    benchmark = ''; study = 'matrix'; shapes = ''; schemes = ''; levels = 0; cfls = 0.0_wp
+    metrics = ''; thresholds = -1.0_wp; min_order = -1.0_wp; quick_levels = 2; quick = .true.
+    open(newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
+    if (ios /= 0) then
+      emsg = path//': cannot open: '//trim(msg); return
+    end if
+    read(u, nml=verify, iostat=ios, iomsg=msg)
+    close(u)
+    if (ios == iostat_end) then
+      emsg = path//': missing group &verify (keys: '//K//')'; return
+    else if (ios /= 0) then
+      emsg = path//': group &verify: '//trim(msg)//' (valid keys: '//K//')'; return
+    end if
+    spec%benchmark = lower(benchmark); spec%study = lower(study)
+    spec%nshape = count(shapes /= ''); spec%shapes = shapes
+    spec%nscheme = count(schemes /= ''); spec%schemes = schemes
+    spec%quick_levels = quick_levels; spec%quick = quick; spec%min_order = min_order
+    if (len_trim(benchmark) == 0) then
+      emsg = path//': group &verify: key ''benchmark'': required'; return
+    end if
+    if (spec%nshape == 0 .or. spec%nscheme == 0) then
+      emsg = path//': group &verify: keys ''shapes'' and ''schemes'': at least one each'; return
+    end if
+    select case (spec%study)
+    case ('matrix')
+      spec%nmetric = count(metrics /= '')
+      spec%metrics = metrics; spec%thresholds = thresholds
+      if (spec%nmetric == 0) then
+        emsg = path//': group &verify: key ''metrics'': at least one for study = ''matrix'''
+        return
+      end if
+      if (any(thresholds(1:spec%nmetric) < 0.0_wp)) then
+        emsg = path//': group &verify: key ''thresholds'': one non-negative threshold per '// &
+          'metric ('//str(spec%nmetric)//' expected)'; return
+      end if
+    case ('space')
+      spec%nlevel = count(levels > 0); spec%levels = levels
+      if (spec%nlevel < 2 .or. any(levels(1:spec%nlevel) <= 0)) then
+        emsg = path//': group &verify: key ''levels'': at least two refinement factors'; return
+      end if
+      spec%nmetric = 1; spec%metrics(1) = metrics(1)
+    case ('time')
+      spec%nlevel = count(cfls > 0.0_wp); spec%cfls = cfls
+      if (spec%nlevel < 2) then
+        emsg = path//': group &verify: key ''cfls'': at least two Courant numbers'; return
+      end if
+      spec%nmetric = 1; spec%metrics(1) = metrics(1)
+    case default
+      emsg = path//': group &verify: key ''study'': expected ''matrix'', ''space'' or '// &
+        '''time'', got '''//trim(study)//''''; return
+    end select
+    if (spec%study /= 'matrix') then
+      if (len_trim(spec%metrics(1)) == 0) then
+        emsg = path//': group &verify: key ''metrics'': the error measure of the study'; return
+      end if
+      if (min_order < 0.0_wp) then
+        emsg = path//': group &verify: key ''min_order'': required for a convergence study'
+        return
+      end if
+      if (quick_levels < 2 .or. quick_levels > spec%nlevel) then
+        emsg = path//': group &verify: key ''quick_levels'': expected 2..'//str(spec%nlevel); return
+      end if
+    end if
+  end subroutine empm_read_verify_spec
+end module empm_verify_spec

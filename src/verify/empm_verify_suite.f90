@@ -1,0 +1,383 @@
+!> The verification suite driver behind `empm verify`: expands every study of the manifest into
+!> runs, filters them by id pattern, runs them with progress and ETA, evaluates metrics and
+!> convergence orders against the exact solutions, and writes raw HDF5 results plus
+!> `summary.json`. Exit semantics: the number of failed checks is returned.
+module empm_verify_suite
+  use, intrinsic :: iso_fortran_env, only: output_unit, error_unit, int64
+  use empm_kinds, only: wp
+  use empm_strings, only: str
+  use empm_error, only: empm_error_t, EMPM_OK
+  use empm_json, only: empm_json_t
+  use empm_version_info, only: empm_version
+  use empm_case, only: empm_case_t, empm_overrides_t
+  use empm_input, only: empm_read_case
+  use empm_history, only: empm_history_t
+  use empm_solver, only: empm_solve
+  use empm_output, only: empm_write_results, empm_output_meta_t
+  use empm_verify_spec, only: empm_verify_spec_t, empm_read_verify_spec
+  use empm_verify_bench, only: bench_prepare, bench_metric, bench_known
+  use empm_verify_metrics, only: observed_orders, fitted_order
+  implicit none
+  private
+  public :: empm_verify_run, empm_glob_match
+
+  !> One run of the suite.
+  type :: run_t
+    character(len=:), allocatable :: id        !! result id (benchmark/scheme/shape[/level])
+    character(len=:), allocatable :: group     !! convergence group id ('' for matrix runs)
+    integer :: spec = 0                        !! index of its study
+    integer :: ishape = 0, ischeme = 0, ilevel = 0
+  end type run_t
+
+contains
+
+  !> Simple glob: `*` matches any run of characters (including '/').
+  pure recursive logical function empm_glob_match(pattern, s) result(m)
+    character(len=*), intent(in) :: pattern !! pattern with '*' wildcards
+    character(len=*), intent(in) :: s       !! candidate
+    integer :: i
+    if (len(pattern) == 0) then
+      m = len(s) == 0; return
+    end if
+    if (pattern(1:1) == '*') then
+      do i = 0, len(s)
+        if (empm_glob_match(pattern(2:), s(i + 1:))) then
+          m = .true.; return
+        end if
+      end do
+      m = .false.
+    else
+      m = len(s) > 0
+      if (m) m = pattern(1:1) == s(1:1)
+      if (m) m = empm_glob_match(pattern(2:), s(2:))
+    end if
+  end function empm_glob_match
+
+  !> Run the suite. `manifest` lists case files (one per line, relative to its folder; `#`
+  !> starts a comment). Only runs whose id matches one of `patterns` run (all if none).
+  !> `quick` runs only the first `quick_levels` levels of convergence studies and skips
+  !> studies marked `quick = .false.`. Results go to `outdir`/raw (HDF5) and `outdir`/summary.json.
+  subroutine empm_verify_run(manifest, outdir, patterns, quick, nfail, err)
+    character(len=*), intent(in) :: manifest          !! path of verification/cases.txt
+    character(len=*), intent(in) :: outdir            !! output folder (created by the caller)
+    character(len=*), intent(in) :: patterns(:)       !! id patterns
+    logical, intent(in) :: quick                      !! quick subset
+    integer, intent(out) :: nfail                     !! failed checks (cases + convergence)
+    type(empm_error_t), intent(out) :: err            !! set on set-up or I/O problems
+    type(empm_verify_spec_t), allocatable :: specs(:)
+    type(run_t), allocatable :: runs(:)
+    real(wp), allocatable :: values(:,:), hval(:)
+    logical, allocatable :: done(:)
+    character(len=:), allocatable :: emsg, dir
+    type(empm_json_t) :: js, jc
+    integer :: i, nrun, nsel
+    integer(int64) :: c0, c1, rate
+    real(wp) :: elapsed
+
+    nfail = 0
+    dir = manifest(1:index(manifest, '/', back=.true.))
+    call read_manifest(manifest, dir, specs, emsg)
+    if (len(emsg) > 0) then
+      err%code = 2; err%message = emsg; return
+    end if
+    call expand(specs, quick, runs)
+    nrun = size(runs)
+    allocate(done(nrun)); done = .false.
+    do i = 1, nrun
+      done(i) = selected(runs(i))
+    end do
+    nsel = count(done)
+    if (nsel == 0) then
+      err%code = 1; err%message = 'no verification run matches the given pattern(s)'; return
+    end if
+    allocate(values(16, nrun), hval(nrun)); values = huge(1.0_wp); hval = 0.0_wp
+
+    call js%begin_object()
+    call js%key('empm_version'); call js%str_value(empm_version())
+    call js%key('generated'); call js%str_value(iso_time())
+    call js%key('quick'); call js%bool_value(quick)
+    call js%key('cases'); call js%begin_array()
+    call jc%begin_array()
+
+    call system_clock(c0, rate)
+    nsel = 0
+    do i = 1, nrun
+      if (.not. done(i)) cycle
+      nsel = nsel + 1
+      call system_clock(c1)
+      elapsed = real(c1 - c0, wp) / rate
+      write(output_unit, '(a,i0,a,i0,a,a)', advance='no') '[', nsel, '/', count(done), '] ', &
+        runs(i)%id
+      if (nsel > 1) write(output_unit, '(a,f7.1,a)', advance='no') '  (ETA ', &
+        elapsed / (nsel - 1) * (count(done) - nsel + 1), ' s)'
+      write(output_unit, '(a)') ''
+      flush(output_unit)
+      call one_run(specs(runs(i)%spec), runs(i), values(:, i), hval(i))
+    end do
+    call js%end_array()
+    call convergence_groups()
+    call jc%end_array()
+    call js%key('convergence'); js%text = js%text//jc%text; js%need_comma = .true.
+    call js%end_object()
+    call write_text(outdir//'/summary.json', js%text)
+    call system_clock(c1)
+    write(output_unit, '(a,i0,a,f8.1,a,i0,a)') 'empm verify: ', count(done), ' runs in ', &
+      real(c1 - c0, wp) / rate, ' s, ', nfail, ' failed check(s); summary: '//outdir// &
+      '/summary.json'
+
+  contains
+
+    logical function selected(r)
+      type(run_t), intent(in) :: r
+      integer :: k
+      selected = size(patterns) == 0
+      do k = 1, size(patterns)
+        if (empm_glob_match(trim(patterns(k)), r%id)) selected = .true.
+        if (len(r%group) > 0) then
+          if (empm_glob_match(trim(patterns(k)), r%group)) selected = .true.
+        end if
+      end do
+    end function selected
+
+    subroutine one_run(spec, r, val, hlevel)
+      type(empm_verify_spec_t), intent(in) :: spec
+      type(run_t), intent(in) :: r
+      real(wp), intent(inout) :: val(:)
+      real(wp), intent(out) :: hlevel
+      type(empm_case_t) :: cs
+      type(empm_history_t) :: hist
+      type(empm_overrides_t) :: ov
+      type(empm_error_t) :: e, ew
+      type(empm_output_meta_t) :: meta
+      character(len=:), allocatable :: out, msg
+      logical :: passed, ran
+      integer :: m
+      ov%shape = trim(spec%shapes(r%ishape)); ov%scheme = trim(spec%schemes(r%ischeme))
+      if (spec%study == 'space') ov%refine = spec%levels(r%ilevel)
+      if (spec%study == 'time') ov%cfl = spec%cfls(r%ilevel)
+      out = outdir//'/raw/'//flat(r%id)//'.h5'
+      ran = .false.; msg = ''
+      call empm_read_case(spec%file, cs, e, ov)
+      if (e%code == EMPM_OK) then
+        call bench_prepare(spec%benchmark, cs, msg)
+        if (len(msg) == 0) then
+          call hist%init(cs%model%grid%ndim, cs%probe_name, cs%probe_particle, 1024, &
+                         size(cs%run%snapshot_times))
+          cs%run%progress = .false.
+          call empm_solve(cs%model, cs%integ, cs%run, hist, e)
+          meta%case_file = spec%file; meta%case_text = cs%text
+          meta%shape = cs%shape_name; meta%integrator = cs%scheme_name
+          meta%cfl = cs%run%cfl; meta%t_end = cs%run%t_end
+          call empm_write_results(out, cs%model, hist, meta, e%code == EMPM_OK, &
+                                  merge(e%message//' ', repeat(' ', len(e%message) + 1), &
+                                  e%code /= EMPM_OK), ew)
+          ran = e%code == EMPM_OK
+          if (.not. ran) msg = e%message
+        end if
+      else
+        msg = e%message
+      end if
+      hlevel = cs%model%grid%hmin()
+      if (spec%study == 'time') hlevel = spec%cfls(r%ilevel)
+      passed = ran
+      do m = 1, spec%nmetric
+        if (ran) then
+          call bench_metric(spec%benchmark, trim(spec%metrics(m)), cs, hist, val(m), msg)
+          if (len(msg) > 0) passed = .false.
+          if (spec%study == 'matrix') then
+            if (.not. (val(m) <= spec%thresholds(m))) passed = .false.
+          end if
+        end if
+      end do
+      if (spec%study /= 'matrix') then
+        if (.not. ran) nfail = nfail + 1
+        if (.not. ran) write(error_unit, '(a)') '  run failed: '//msg
+        return
+      end if
+      if (.not. passed) nfail = nfail + 1
+      call js%begin_object()
+      call js%key('id'); call js%str_value(r%id)
+      call js%key('metrics'); call js%begin_object()
+      do m = 1, spec%nmetric
+        call js%key(trim(spec%metrics(m))); call js%real_value(val(m))
+      end do
+      call js%end_object()
+      call js%key('thresholds'); call js%begin_object()
+      do m = 1, spec%nmetric
+        call js%key(trim(spec%metrics(m))); call js%real_value(spec%thresholds(m))
+      end do
+      call js%end_object()
+      call js%key('passed'); call js%bool_value(passed)
+      call js%key('completed'); call js%bool_value(ran)
+      if (len(msg) > 0) then
+        call js%key('message'); call js%str_value(msg)
+      end if
+      call js%key('output'); call js%str_value(out)
+      call js%end_object()
+      write(output_unit, '(a)', advance='no') '    '//merge('pass', 'FAIL', passed)
+      do m = 1, spec%nmetric
+        write(output_unit, '(a)', advance='no') '  '//trim(spec%metrics(m))//' = '// &
+          str(val(m))//' (<= '//str(spec%thresholds(m))//')'
+      end do
+      write(output_unit, '(a)') ''
+      if (len(msg) > 0) write(output_unit, '(a)') '    '//msg
+    end subroutine one_run
+
+    subroutine convergence_groups()
+      integer :: a, b, n, k
+      real(wp), allocatable :: hs(:), es(:), p(:)
+      real(wp) :: order
+      logical :: ok
+      a = 1
+      do while (a <= nrun)
+        if (len(runs(a)%group) == 0 .or. .not. done(a)) then
+          a = a + 1; cycle
+        end if
+        b = a
+        do while (b < nrun)
+          if (runs(b + 1)%group /= runs(a)%group) exit
+          b = b + 1
+        end do
+        n = count(done(a:b))
+        hs = pack(hval(a:b), done(a:b)); es = pack(values(1, a:b), done(a:b))
+        ok = n >= 2 .and. all(es > 0.0_wp .and. es < huge(1.0_wp))
+        order = 0.0_wp
+        if (ok) then
+          p = observed_orders(hs, es)
+          order = p(size(p))
+          ok = order >= specs(runs(a)%spec)%min_order
+        end if
+        if (.not. ok) nfail = nfail + 1
+        call jc%begin_object()
+        call jc%key('id'); call jc%str_value(runs(a)%group)
+        call jc%key('parameter'); call jc%str_value(merge('h  ', 'cfl', &
+          specs(runs(a)%spec)%study == 'space'))
+        call jc%key('metric'); call jc%str_value(trim(specs(runs(a)%spec)%metrics(1)))
+        call jc%key('values'); call jc%real_array(hs)
+        call jc%key('errors'); call jc%real_array(es)
+        call jc%key('observed_order'); call jc%real_value(order)
+        if (n >= 2) then
+          call jc%key('fitted_order'); call jc%real_value(fitted_order(hs, es))
+        end if
+        call jc%key('min_order'); call jc%real_value(specs(runs(a)%spec)%min_order)
+        call jc%key('passed'); call jc%bool_value(ok)
+        call jc%key('outputs'); call jc%begin_array()
+        do k = a, b
+          if (done(k)) call jc%str_value(outdir//'/raw/'//flat(runs(k)%id)//'.h5')
+        end do
+        call jc%end_array()
+        call jc%end_object()
+        write(output_unit, '(a)') merge('pass ', 'FAIL ', ok)//runs(a)%group//': errors '// &
+          join(es)//' observed order '//str(order)//' (>= '// &
+          str(specs(runs(a)%spec)%min_order)//')'
+        a = b + 1
+      end do
+    end subroutine convergence_groups
+  end subroutine empm_verify_run
+
+  pure function join(x) result(s)
+    real(wp), intent(in) :: x(:)
+    character(len=:), allocatable :: s
+    integer :: i
+    s = ''
+    do i = 1, size(x)
+      s = s//str(x(i))
+      if (i < size(x)) s = s//' '
+    end do
+  end function join
+
+  !> Run id with '/' made file-name safe.
+  pure function flat(id) result(s)
+    character(len=*), intent(in) :: id
+    character(len=len(id)) :: s
+    integer :: i
+    s = id
+    do i = 1, len(s)
+      if (s(i:i) == '/') s(i:i) = '_'
+    end do
+  end function flat
+
+  subroutine read_manifest(manifest, dir, specs, emsg)
+    character(len=*), intent(in) :: manifest, dir
+    type(empm_verify_spec_t), allocatable, intent(out) :: specs(:)
+    character(len=:), allocatable, intent(out) :: emsg
+    type(empm_verify_spec_t), allocatable :: tmp(:)
+    type(empm_verify_spec_t) :: sp
+    character(len=512) :: line
+    integer :: u, ios, n
+    emsg = ''
+    allocate(specs(0))
+    open(newunit=u, file=manifest, status='old', action='read', iostat=ios)
+    if (ios /= 0) then
+      emsg = manifest//': cannot open the verification manifest'; return
+    end if
+    do
+      read(u, '(a)', iostat=ios) line
+      if (ios /= 0) exit
+      line = adjustl(line)
+      if (len_trim(line) == 0 .or. line(1:1) == '#') cycle
+      call empm_read_verify_spec(dir//trim(line), sp, emsg)
+      if (len(emsg) > 0) exit
+      if (.not. bench_known(sp%benchmark)) then
+        emsg = dir//trim(line)//': group &verify: unknown benchmark '''//trim(sp%benchmark)//''''
+        exit
+      end if
+      n = size(specs)
+      allocate(tmp(n + 1)); tmp(1:n) = specs; tmp(n + 1) = sp
+      call move_alloc(tmp, specs)
+    end do
+    close(u)
+  end subroutine read_manifest
+
+  subroutine expand(specs, quick, runs)
+    type(empm_verify_spec_t), intent(in) :: specs(:)
+    logical, intent(in) :: quick
+    type(run_t), allocatable, intent(out) :: runs(:)
+    type(run_t), allocatable :: tmp(:)
+    integer :: s, i, j, l, nl, n
+    type(run_t) :: r
+    allocate(runs(0))
+    do s = 1, size(specs)
+      if (quick .and. .not. specs(s)%quick) cycle
+      nl = max(1, specs(s)%nlevel)
+      if (quick .and. specs(s)%study /= 'matrix') nl = specs(s)%quick_levels
+      do j = 1, specs(s)%nscheme
+        do i = 1, specs(s)%nshape
+          do l = 1, nl
+            r%spec = s; r%ishape = i; r%ischeme = j; r%ilevel = l
+            if (specs(s)%study == 'matrix') then
+              r%group = ''
+              r%id = trim(specs(s)%benchmark)//'/'//trim(specs(s)%schemes(j))//'/'// &
+                trim(specs(s)%shapes(i))
+            else
+              r%group = trim(specs(s)%benchmark)//'/'//trim(specs(s)%study)//'/'// &
+                trim(specs(s)%schemes(j))//'/'//trim(specs(s)%shapes(i))
+              r%id = r%group//'/'//str(l)
+            end if
+            n = size(runs)
+            allocate(tmp(n + 1)); tmp(1:n) = runs; tmp(n + 1) = r
+            call move_alloc(tmp, runs)
+          end do
+        end do
+      end do
+    end do
+  end subroutine expand
+
+  subroutine write_text(path, text)
+    character(len=*), intent(in) :: path, text
+    integer :: u
+    open(newunit=u, file=path, status='replace', action='write')
+    write(u, '(a)') text
+    close(u)
+  end subroutine write_text
+
+  !> Current local time as ISO 8601 (e.g. 2026-11-21T05:19:14+00:00).
+  function iso_time() result(s)
+    character(len=:), allocatable :: s
+    character(len=8) :: d
+    character(len=10) :: t
+    character(len=5) :: z
+    call date_and_time(d, t, z)
+    s = d(1:4)//'-'//d(5:6)//'-'//d(7:8)//'T'//t(1:2)//':'//t(3:4)//':'//t(5:6)//z(1:3)//':'//z(4:5)
+  end function iso_time
+end module empm_verify_suite
