@@ -1,17 +1,49 @@
 !> Benchmarks of the verification suite: the exact or manufactured solution behind each
-!> benchmark id, the initial state and body force it needs, and the metrics computed from a
-!> run against it. Definitions: ../shared/docs/algorithms.md §3 and docs/verification.md.
+!> benchmark id, the initial state and body force it needs, the metrics computed from a run
+!> against it, and the exact fields stored beside the run for the report's plots.
+!> Definitions: ../shared/docs/algorithms.md §3; metrics: docs/verification.md.
 module empm_verify_bench
+  use hdf5, only: h5open_f, h5fopen_f, h5fclose_f, H5F_ACC_RDWR_F
   use empm_kinds, only: wp
+  use empm_strings, only: str
   use empm_case, only: empm_case_t
   use empm_history, only: empm_history_t
+  use empm_h5, only: hid_t, h5_group, h5_close_group, h5_write, h5_attr
+  use empm_tensor, only: det3, mat_to_voigt, identity3
   use empm_verify_metrics, only: rms_error, weighted_l2, history_l2, noise_share
   use empm_exact_bar, only: empm_vibrating_bar_t
+  use empm_exact_characteristics, only: empm_char_bar_t, empm_dyka_bar
+  use empm_exact_column, only: empm_column_t, empm_andersen_column
+  use empm_mms_linear, only: empm_mms_linear_1d_t, empm_mms_linear_2d_t
+  use empm_mms_neohookean, only: empm_mms_neohookean_1d_t, empm_mms_axis_aligned_2d_t
   implicit none
   private
-  public :: bench_prepare, bench_metric, bench_known
+  public :: empm_bench_t, bench_known
 
-  character(len=*), parameter :: KNOWN = 'vibrating_bar'
+  character(len=*), parameter :: KNOWN = 'dyka vibrating_bar andersen mms_linear_1d '// &
+    'mms_linear_2d mms_neohookean_1d mms_axis_aligned_2d colliding_disks'
+
+  !> A benchmark: its exact solution and the scales that make errors relative.
+  type :: empm_bench_t
+    character(len=32) :: id = ''                !! benchmark id
+    real(wp) :: vscale = 1.0_wp                 !! velocity scale [m/s]
+    real(wp) :: uscale = 1.0_wp                 !! displacement scale [m]
+    real(wp) :: sscale = 1.0_wp                 !! stress scale [Pa]
+    real(wp) :: fcut = 0.0_wp                   !! noise cutoff frequency [Hz] (dyka)
+    type(empm_char_bar_t) :: dyka               !! Dyka bar by characteristics
+    type(empm_vibrating_bar_t) :: bar           !! vibrating bar
+    type(empm_column_t) :: column               !! self-weight column (Andersen block)
+    type(empm_mms_linear_1d_t) :: ml1           !! linear MMS, 1D
+    type(empm_mms_linear_2d_t) :: ml2           !! linear MMS, 2D
+    type(empm_mms_neohookean_1d_t) :: nh1       !! neo-Hookean MMS, 1D (Steffen)
+    type(empm_mms_axis_aligned_2d_t) :: aa2     !! axis-aligned MMS, 2D (Wallstedt & Guilkey)
+  contains
+    procedure :: prepare => bench_prepare
+    procedure :: metric => bench_metric
+    procedure :: exact => bench_exact
+    procedure :: has_exact => bench_has_exact
+    procedure :: write_exact => bench_write_exact
+  end type empm_bench_t
 
 contains
 
@@ -21,87 +53,272 @@ contains
     bench_known = index(' '//KNOWN//' ', ' '//trim(benchmark)//' ') > 0
   end function bench_known
 
-  !> Impose what the benchmark needs beyond the case file (initial fields from the exact
-  !> solution, body forces). `emsg` is '' on success.
-  subroutine bench_prepare(benchmark, cs, emsg)
-    character(len=*), intent(in) :: benchmark          !! benchmark id
+  !> True when the benchmark has a pointwise exact solution.
+  elemental logical function bench_has_exact(self)
+    class(empm_bench_t), intent(in) :: self !! benchmark
+    bench_has_exact = self%id /= 'colliding_disks'
+  end function bench_has_exact
+
+  !> Exact displacement, velocity and Cauchy stress (Voigt) at reference position `X`, time `t`.
+  subroutine bench_exact(self, X, t, u, v, s)
+    class(empm_bench_t), intent(in) :: self  !! benchmark
+    real(wp), intent(in) :: X(:)             !! reference position (ndim)
+    real(wp), intent(in) :: t                !! time [s]
+    real(wp), intent(out) :: u(size(X))      !! displacement [m]
+    real(wp), intent(out) :: v(size(X))      !! velocity [m/s]
+    real(wp), intent(out) :: s(6)            !! stress [Pa]
+    u = 0.0_wp; v = 0.0_wp; s = 0.0_wp
+    select case (trim(self%id))
+    case ('dyka')
+      ! Small-strain theory: the displacement is not tracked by characteristics.
+      v(1) = self%dyka%velocity(X(1), t); s(1) = self%dyka%stress(X(1), t)
+    case ('vibrating_bar')
+      u(1) = self%bar%displacement(X(1), t); v(1) = self%bar%velocity(X(1), t)
+      s(1) = self%bar%stress(X(1), t)
+    case ('andersen')
+      ! 1D uniaxial-strain column along y (plane strain, rollers, nu = 0).
+      u(2) = self%column%displacement(X(2), t); v(2) = self%column%velocity(X(2), t)
+      s(2) = self%column%stress(X(2), t)
+    case ('mms_linear_1d')
+      u = self%ml1%displacement(X, t); v = self%ml1%velocity(X, t); s = self%ml1%stress(X, t)
+    case ('mms_linear_2d')
+      u = self%ml2%displacement(X, t); v = self%ml2%velocity(X, t); s = self%ml2%stress(X, t)
+    case ('mms_neohookean_1d')
+      u = self%nh1%displacement(X, t); v = self%nh1%velocity(X, t); s = self%nh1%stress(X, t)
+    case ('mms_axis_aligned_2d')
+      u = self%aa2%displacement(X, t); v = self%aa2%velocity(X, t); s = self%aa2%stress(X, t)
+    end select
+  end subroutine bench_exact
+
+  !> Set the benchmark up for `cs`: check the case against the exact solution's data, and
+  !> impose what the benchmark needs beyond the case file (initial fields, body forces).
+  subroutine bench_prepare(self, id, cs, emsg)
+    class(empm_bench_t), intent(inout) :: self         !! benchmark
+    character(len=*), intent(in) :: id                 !! benchmark id
     type(empm_case_t), intent(inout) :: cs             !! case read from its file
     character(len=:), allocatable, intent(out) :: emsg !! '' or the problem
-    integer :: p
+    real(wp) :: c_case
+    integer :: p, np
     emsg = ''
-    associate (pts => cs%model%pts)
-      select case (trim(benchmark))
-      case ('vibrating_bar')
-        ! The case file gives the sine velocity already; check it matches the exact mode.
-        block
-          type(empm_vibrating_bar_t) :: bar
-          do p = 1, pts%np
-            if (abs(pts%v(1, p) - bar%velocity(pts%x0(1, p), 0.0_wp)) > 1.0e-12_wp * bar%v0) then
-              emsg = cs%file//': the initial velocity does not match the exact vibrating-bar mode'
-              return
-            end if
-          end do
-        end block
-      case default
-        emsg = 'unknown benchmark '''//trim(benchmark)//'''; known: '//KNOWN
-      end select
-    end associate
+    self%id = id
+    np = cs%model%pts%np
+    c_case = cs%model%mats(1)%model%wave_speed(cs%model%mats(1)%model%rho0)
+    select case (trim(id))
+    case ('dyka')
+      self%dyka = empm_dyka_bar()
+      call expect_speed(self%dyka%wave_speed())
+      self%vscale = 5.0_wp; self%sscale = self%dyka%impedance() * 5.0_wp
+      ! Wavelengths shorter than 8h travel more than 2.5 % slow on the grid (lumped linear
+      ! elements: sin(kh/2)/(kh/2) at kh = pi/4): content above c/(8h) is numerical noise.
+      self%fcut = self%dyka%wave_speed() / (8.0_wp * cs%model%grid%hmin())
+    case ('vibrating_bar')
+      ! Amplitude from the initial velocities (least squares on sin(beta X)).
+      self%bar%v0 = sum(cs%model%pts%v(1, 1:np) * sin(self%bar%beta() * cs%model%pts%x0(1, 1:np))) &
+                    / sum(sin(self%bar%beta() * cs%model%pts%x0(1, 1:np))**2)
+      call expect_speed(sqrt(self%bar%E / self%bar%rho))
+      do p = 1, np
+        if (abs(cs%model%pts%v(1, p) - self%bar%velocity(cs%model%pts%x0(1, p), 0.0_wp)) > &
+            1.0e-12_wp * abs(self%bar%v0)) emsg = cs%file// &
+          ': the initial velocity is not the first mode of the vibrating bar (L = 25, E = 100)'
+      end do
+      self%vscale = abs(self%bar%v0)
+      self%uscale = abs(self%bar%v0) / self%bar%omega()
+      self%sscale = self%bar%E * self%bar%beta() * self%uscale
+    case ('andersen')
+      self%column = empm_andersen_column()
+      call expect_speed(self%column%wave_speed())
+      self%sscale = self%column%rho * self%column%g * self%column%H
+      self%uscale = self%column%settlement()
+      self%vscale = self%uscale * 2.0_wp * acos(-1.0_wp) / self%column%period()
+    case ('mms_linear_1d')
+      call expect_speed(sqrt(self%ml1%modulus() / self%ml1%rho))
+      call set_initial_state(cs)
+      allocate(cs%model%loads%body_force, source=self%ml1)
+      self%uscale = self%ml1%A
+    case ('mms_linear_2d')
+      call set_initial_state(cs)
+      allocate(cs%model%loads%body_force, source=self%ml2)
+      self%uscale = self%ml2%A
+    case ('mms_neohookean_1d')
+      call set_initial_state(cs)
+      allocate(cs%model%loads%body_force, source=self%nh1)
+      self%uscale = self%nh1%A
+    case ('mms_axis_aligned_2d')
+      call set_initial_state(cs)
+      allocate(cs%model%loads%body_force, source=self%aa2)
+      self%uscale = self%aa2%A
+    case ('colliding_disks')
+    case default
+      emsg = 'unknown benchmark '''//trim(id)//'''; known: '//KNOWN
+    end select
+
+  contains
+
+    subroutine expect_speed(c)
+      real(wp), intent(in) :: c
+      if (abs(c_case - c) > 1.0e-10_wp * c) emsg = cs%file//': the material of the case '// &
+        '(wave speed '//str(c_case)//' m/s) differs from the '//trim(id)//' benchmark''s ('// &
+        str(c)//' m/s)'
+    end subroutine expect_speed
+
+    ! Particles start on the manufactured solution: x = X + u(X,0), v, F, stress, density.
+    subroutine set_initial_state(cs)
+      type(empm_case_t), intent(inout) :: cs
+      real(wp) :: u(3), v(3), s(6), F(3, 3), J
+      integer :: q, d
+      d = cs%model%grid%ndim
+      do q = 1, cs%model%pts%np
+        associate (X => cs%model%pts%x0(:, q))
+          call self%exact(X, 0.0_wp, u(1:d), v(1:d), s)
+          select case (trim(self%id))
+          case ('mms_linear_1d'); F = self%ml1%def_grad(X, 0.0_wp)
+          case ('mms_linear_2d'); F = self%ml2%def_grad(X, 0.0_wp)
+          case ('mms_neohookean_1d'); F = self%nh1%def_grad(X, 0.0_wp)
+          case default; F = self%aa2%def_grad(X, 0.0_wp)
+          end select
+        end associate
+        J = det3(F)
+        cs%model%pts%x(:, q) = cs%model%pts%x0(:, q) + u(1:d)
+        cs%model%pts%v(:, q) = v(1:d)
+        cs%model%pts%F(:, :, q) = F
+        cs%model%pts%strain(:, q) = mat_to_voigt(F - identity3())
+        cs%model%pts%stress(:, q) = s
+        cs%model%pts%rho(q) = cs%model%pts%rho(q) / J
+        cs%model%pts%vol(q) = cs%model%pts%vol0(q) * J
+      end do
+    end subroutine set_initial_state
   end subroutine bench_prepare
 
   !> Compute metric `name` of a finished run. `emsg` is '' on success.
-  subroutine bench_metric(benchmark, name, cs, hist, value, emsg)
-    character(len=*), intent(in) :: benchmark          !! benchmark id
+  subroutine bench_metric(self, name, cs, hist, value, emsg)
+    class(empm_bench_t), intent(in) :: self            !! benchmark
     character(len=*), intent(in) :: name               !! metric name
     type(empm_case_t), intent(in) :: cs                !! the run (final state)
     type(empm_history_t), intent(in) :: hist           !! its histories
     real(wp), intent(out) :: value                     !! metric value
     character(len=:), allocatable, intent(out) :: emsg !! '' or the problem
-    real(wp), allocatable :: vex(:,:)
-    integer :: np, d
+    real(wp), allocatable :: ue(:,:), ve(:,:), se(:,:), pv(:), ps(:)
+    real(wp) :: g
+    integer :: np, d, p, k, info, i0
     emsg = ''; value = huge(1.0_wp)
     np = cs%model%pts%np; d = cs%model%grid%ndim
-    allocate(vex(d, np))
-    call exact_velocity(benchmark, cs%model%pts%x0(:, 1:np), cs%model%t, vex, emsg)
-    if (len(emsg) > 0) return
-    select case (trim(name))
-    case ('rms_velocity')
-      value = rms_error(cs%model%pts%v(1, 1:np), vex(1, :))
-    case ('velocity_l2')
-      value = weighted_l2(cs%model%pts%vol0(1:np), cs%model%pts%v(:, 1:np), vex)
-    case ('relative_velocity_l2')
-      value = weighted_l2(cs%model%pts%vol0(1:np), cs%model%pts%v(:, 1:np), vex) / &
-              velocity_scale(benchmark)
-    case default
-      emsg = 'unknown metric '''//trim(name)//''' for benchmark '''//trim(benchmark)//''''
-    end select
-    if (hist%nt < 0) emsg = 'corrupt history'
+    allocate(ue(d, np), ve(d, np), se(6, np))
+    if (self%has_exact()) then
+      do p = 1, np
+        call self%exact(cs%model%pts%x0(:, p), cs%model%t, ue(:, p), ve(:, p), se(:, p))
+      end do
+    end if
+    associate (pts => cs%model%pts)
+      select case (trim(name))
+      case ('rms_velocity')
+        ! Paper eq. (45), axial component, at the final time [m/s].
+        value = rms_error(pts%v(1, 1:np), ve(1, :))
+      case ('velocity_l2')
+        value = weighted_l2(pts%vol0(1:np), pts%v(:, 1:np), ve) / self%vscale
+      case ('displacement_l2')
+        value = weighted_l2(pts%vol0(1:np), pts%x(:, 1:np) - pts%x0(:, 1:np), ue) / self%uscale
+      case ('stress_l2')
+        value = weighted_l2(pts%vol0(1:np), pts%stress(:, 1:np), se) / self%sscale
+      case ('history_l2_velocity', 'noise_share', 'history_l2_stress')
+        k = merge(2, 1, trim(name) == 'history_l2_stress')
+        if (hist%nprobe < k) then
+          emsg = trim(name)//' needs probe '//str(k)//' in the case file'; return
+        end if
+        call probe_exact(k, pv, ps)
+        if (trim(name) == 'history_l2_velocity') then
+          value = history_l2(hist%t(1:hist%nt), hist%pv(1, k, 1:hist%nt), pv) / self%vscale
+        else if (trim(name) == 'history_l2_stress') then
+          value = history_l2(hist%t(1:hist%nt), hist%ps(1, k, 1:hist%nt), ps) / self%sscale
+        else
+          call noise_share(hist%t(1:hist%nt), hist%pv(1, k, 1:hist%nt), pv, self%fcut, value, info)
+          if (info /= 0) emsg = 'noise_share: spectrum failed (status '//str(info)//')'
+        end if
+      case ('base_stress_error')
+        ! Bottom row of particles: sigma_yy against the exact column at their reference height.
+        g = minval(pts%x0(2, 1:np))
+        value = maxval(abs(pts%stress(2, 1:np) - se(2, :)), mask=pts%x0(2, 1:np) <= g + 1.0e-9_wp) &
+                / self%sscale
+      case ('profile_error')
+        value = rms_error(pts%stress(2, 1:np), se(2, :)) / self%sscale
+      case ('settlement_error')
+        ! Top particle against the small-strain static displacement at its height.
+        i0 = maxloc(pts%x0(2, 1:np), dim=1)
+        value = abs((pts%x(2, i0) - pts%x0(2, i0)) - &
+                    self%column%static_displacement(pts%x0(2, i0))) / self%uscale
+      case ('max_speed')
+        value = sqrt(maxval(sum(pts%v(:, 1:np)**2, dim=1))) / self%vscale
+      case ('energy_growth')
+        ! max_t E(t)/E(0) - 1: an explicit scheme that is stable and dissipative never gains.
+        value = maxval(hist%kinetic(1:hist%nt) + hist%strain(1:hist%nt)) / &
+                (hist%kinetic(1) + hist%strain(1)) - 1.0_wp
+      case ('energy_loss')
+        value = 1.0_wp - (hist%kinetic(hist%nt) + hist%strain(hist%nt)) / &
+                (hist%kinetic(1) + hist%strain(1))
+      case default
+        emsg = 'unknown metric '''//trim(name)//''''
+      end select
+    end associate
+
+  contains
+
+    subroutine probe_exact(k, pv, ps)
+      integer, intent(in) :: k
+      real(wp), allocatable, intent(out) :: pv(:), ps(:)
+      real(wp) :: u(d), v(d), s(6)
+      integer :: i
+      allocate(pv(hist%nt), ps(hist%nt))
+      do i = 1, hist%nt
+        call self%exact(cs%model%pts%x0(:, hist%probe_particle(k)), hist%t(i), u, v, s)
+        pv(i) = v(1); ps(i) = s(1)
+      end do
+    end subroutine probe_exact
   end subroutine bench_metric
 
-  !> Velocity scale used to make errors relative (the benchmark's amplitude).
-  pure real(wp) function velocity_scale(benchmark) result(s)
-    character(len=*), intent(in) :: benchmark
-    type(empm_vibrating_bar_t) :: bar
-    select case (trim(benchmark))
-    case ('vibrating_bar'); s = bar%v0
-    case default; s = 1.0_wp
-    end select
-  end function velocity_scale
-
-  !> Exact velocity at reference positions `x0` and time `t`.
-  subroutine exact_velocity(benchmark, x0, t, v, emsg)
-    character(len=*), intent(in) :: benchmark
-    real(wp), intent(in) :: x0(:,:), t
-    real(wp), intent(out) :: v(:,:)
-    character(len=:), allocatable, intent(out) :: emsg
-    emsg = ''
-    select case (trim(benchmark))
-    case ('vibrating_bar')
-      block
-        type(empm_vibrating_bar_t) :: bar
-        v(1, :) = bar%velocity(x0(1, :), t)
-      end block
-    case default
-      emsg = 'no exact velocity for benchmark '''//trim(benchmark)//''''
-    end select
-  end subroutine exact_velocity
+  !> Store the exact fields beside a run in its HDF5 file, group /verification: exact
+  !> velocity and stress histories at every probe, exact final displacement, velocity and
+  !> stress at the particles, and the benchmark's scales.
+  subroutine bench_write_exact(self, path, cs, hist, ierr)
+    class(empm_bench_t), intent(in) :: self      !! benchmark
+    character(len=*), intent(in) :: path         !! the run's HDF5 file (complete)
+    type(empm_case_t), intent(in) :: cs          !! the run
+    type(empm_history_t), intent(in) :: hist     !! its histories
+    integer, intent(out) :: ierr                 !! 0 ok
+    integer(hid_t) :: fid, g, gp
+    real(wp), allocatable :: ue(:,:), ve(:,:), se(:,:), hv(:,:), hs(:,:)
+    integer :: e, p, k, i, d, np
+    ierr = 0
+    d = cs%model%grid%ndim; np = cs%model%pts%np
+    call h5open_f(e)
+    call h5fopen_f(path, H5F_ACC_RDWR_F, fid, e)
+    if (e /= 0) then
+      ierr = 1; return
+    end if
+    call h5_group(fid, 'verification', g, ierr)
+    call h5_attr(g, 'benchmark', trim(self%id), ierr)
+    call h5_attr(g, 'velocity_scale', self%vscale, ierr)
+    call h5_attr(g, 'displacement_scale', self%uscale, ierr)
+    call h5_attr(g, 'stress_scale', self%sscale, ierr)
+    if (self%has_exact()) then
+      allocate(ue(d, np), ve(d, np), se(6, np), hv(d, hist%nt), hs(6, hist%nt))
+      do p = 1, np
+        call self%exact(cs%model%pts%x0(:, p), cs%model%t, ue(:, p), ve(:, p), se(:, p))
+      end do
+      call h5_write(g, 'final_displacement', ue, ierr)
+      call h5_write(g, 'final_velocity', ve, ierr)
+      call h5_write(g, 'final_stress', se, ierr)
+      do k = 1, hist%nprobe
+        do i = 1, hist%nt
+          call self%exact(cs%model%pts%x0(:, hist%probe_particle(k)), hist%t(i), ue(:, 1), &
+                          hv(:, i), hs(:, i))
+        end do
+        call h5_group(g, 'probe_'//trim(hist%probe_name(k)), gp, ierr)
+        call h5_write(gp, 'v', hv, ierr)
+        call h5_write(gp, 'stress', hs, ierr)
+        call h5_close_group(gp, ierr)
+      end do
+    end if
+    call h5_close_group(g, ierr)
+    call h5fclose_f(fid, e)
+    if (e /= 0) ierr = e
+  end subroutine bench_write_exact
 end module empm_verify_bench

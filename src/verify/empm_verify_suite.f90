@@ -15,7 +15,7 @@ module empm_verify_suite
   use empm_solver, only: empm_solve
   use empm_output, only: empm_write_results, empm_output_meta_t
   use empm_verify_spec, only: empm_verify_spec_t, empm_read_verify_spec
-  use empm_verify_bench, only: bench_prepare, bench_metric, bench_known
+  use empm_verify_bench, only: empm_bench_t, bench_known
   use empm_verify_metrics, only: observed_orders, fitted_order
   implicit none
   private
@@ -149,9 +149,10 @@ contains
       type(empm_overrides_t) :: ov
       type(empm_error_t) :: e, ew
       type(empm_output_meta_t) :: meta
+      type(empm_bench_t) :: bench
       character(len=:), allocatable :: out, msg
       logical :: passed, ran
-      integer :: m
+      integer :: m, ierr
       ov%shape = trim(spec%shapes(r%ishape)); ov%scheme = trim(spec%schemes(r%ischeme))
       if (spec%study == 'space') ov%refine = spec%levels(r%ilevel)
       if (spec%study == 'time') ov%cfl = spec%cfls(r%ilevel)
@@ -159,7 +160,7 @@ contains
       ran = .false.; msg = ''
       call empm_read_case(spec%file, cs, e, ov)
       if (e%code == EMPM_OK) then
-        call bench_prepare(spec%benchmark, cs, msg)
+        call bench%prepare(spec%benchmark, cs, msg)
         if (len(msg) == 0) then
           call hist%init(cs%model%grid%ndim, cs%probe_name, cs%probe_particle, 1024, &
                          size(cs%run%snapshot_times))
@@ -173,6 +174,7 @@ contains
                                   e%code /= EMPM_OK), ew)
           ran = e%code == EMPM_OK
           if (.not. ran) msg = e%message
+          if (ew%code == EMPM_OK) call bench%write_exact(out, cs, hist, ierr)
         end if
       else
         msg = e%message
@@ -182,7 +184,7 @@ contains
       passed = ran
       do m = 1, spec%nmetric
         if (ran) then
-          call bench_metric(spec%benchmark, trim(spec%metrics(m)), cs, hist, val(m), msg)
+          call bench%metric(trim(spec%metrics(m)), cs, hist, val(m), msg)
           if (len(msg) > 0) passed = .false.
           if (spec%study == 'matrix') then
             if (.not. (val(m) <= spec%thresholds(m))) passed = .false.
