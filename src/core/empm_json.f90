@@ -13,7 +13,7 @@ module empm_json
   contains
     procedure :: begin_object, end_object, begin_array, end_array
     procedure :: key
-    procedure :: str_value, real_value, int_value, bool_value, real_array
+    procedure :: str_value, real_value, int_value, bool_value, null_value, real_array
   end type empm_json_t
 
 contains
@@ -85,6 +85,12 @@ contains
     logical, intent(in) :: b                  !! value
     call sep(self); self%text = self%text//trim(merge('true ', 'false', b)); self%need_comma = .true.
   end subroutine bool_value
+
+  !> Write null.
+  subroutine null_value(self)
+    class(empm_json_t), intent(inout) :: self !! document
+    call sep(self); self%text = self%text//'null'; self%need_comma = .true.
+  end subroutine null_value
 
   !> Write an array of numbers.
   subroutine real_array(self, x)

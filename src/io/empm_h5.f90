@@ -50,10 +50,12 @@ contains
     integer(hsize_t) :: dims(1)
     integer(hid_t) :: sid, did
     integer :: e(4)
+    real(wp), allocatable :: buf(:)
     dims = shape(a, kind=hsize_t)
+    buf = a  ! contiguous copy for the C library (a may be a strided section)
     call h5screate_simple_f(1, dims, sid, e(1))
     call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, sid, did, e(2))
-    call h5dwrite_f(did, H5T_NATIVE_DOUBLE, a, dims, e(3))
+    call h5dwrite_f(did, H5T_NATIVE_DOUBLE, buf, dims, e(3))
     call h5dclose_f(did, e(4)); call h5sclose_f(sid, e(1))
     if (any(e /= 0)) ierr = 1
   end subroutine write_r1
@@ -66,10 +68,12 @@ contains
     integer(hsize_t) :: dims(2)
     integer(hid_t) :: sid, did
     integer :: e(4)
+    real(wp), allocatable :: buf(:, :)
     dims = shape(a, kind=hsize_t)
+    buf = a  ! contiguous copy for the C library (a may be a strided section)
     call h5screate_simple_f(2, dims, sid, e(1))
     call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, sid, did, e(2))
-    call h5dwrite_f(did, H5T_NATIVE_DOUBLE, a, dims, e(3))
+    call h5dwrite_f(did, H5T_NATIVE_DOUBLE, buf, dims, e(3))
     call h5dclose_f(did, e(4)); call h5sclose_f(sid, e(1))
     if (any(e /= 0)) ierr = 1
   end subroutine write_r2
@@ -82,10 +86,12 @@ contains
     integer(hsize_t) :: dims(1)
     integer(hid_t) :: sid, did
     integer :: e(4)
+    integer, allocatable :: buf(:)
     dims = shape(a, kind=hsize_t)
+    buf = a  ! contiguous copy for the C library (a may be a strided section)
     call h5screate_simple_f(1, dims, sid, e(1))
     call h5dcreate_f(loc, name, H5T_NATIVE_INTEGER, sid, did, e(2))
-    call h5dwrite_f(did, H5T_NATIVE_INTEGER, a, dims, e(3))
+    call h5dwrite_f(did, H5T_NATIVE_INTEGER, buf, dims, e(3))
     call h5dclose_f(did, e(4)); call h5sclose_f(sid, e(1))
     if (any(e /= 0)) ierr = 1
   end subroutine write_i1

@@ -24,6 +24,8 @@ module empm_verify_spec
     character(len=32) :: metrics(MAXLIST) = ''   !! matrix study: metric names
     real(wp) :: thresholds(MAXLIST) = 0.0_wp     !! matrix study: upper bounds
     real(wp) :: min_order = 0.0_wp               !! convergence study: required order
+    real(wp) :: max_order = huge(1.0_wp)         !! convergence study: order must stay below
+                                                 !! (to assert a known loss of convergence)
     integer :: quick_levels = 2                  !! convergence levels run in quick mode
     logical :: quick = .true.                    !! included in the quick subset
   end type empm_verify_spec_t
@@ -36,19 +38,20 @@ contains
     type(empm_verify_spec_t), intent(out) :: spec            !! the study
     character(len=:), allocatable, intent(out) :: emsg       !! '' or the problem
     character(len=*), parameter :: K = 'benchmark, study, shapes, schemes, levels, cfls, '// &
-      'metrics, thresholds, min_order, quick_levels, quick'
+      'metrics, thresholds, min_order, max_order, quick_levels, quick'
     character(len=32) :: benchmark, metrics(MAXLIST)
     character(len=16) :: study, shapes(MAXLIST), schemes(MAXLIST)
     integer :: levels(MAXLIST), quick_levels, u, ios
-    real(wp) :: cfls(MAXLIST), thresholds(MAXLIST), min_order
+    real(wp) :: cfls(MAXLIST), thresholds(MAXLIST), min_order, max_order
     logical :: quick
     character(len=512) :: msg
     namelist /verify/ benchmark, study, shapes, schemes, levels, cfls, metrics, thresholds, &
-      min_order, quick_levels, quick
+      min_order, max_order, quick_levels, quick
     emsg = ''
     spec%file = path
     benchmark = ''; study = 'matrix'; shapes = ''; schemes = ''; levels = 0; cfls = 0.0_wp
-    metrics = ''; thresholds = -1.0_wp; min_order = -1.0_wp; quick_levels = 2; quick = .true.
+    metrics = ''; thresholds = -huge(1.0_wp); min_order = -huge(1.0_wp); max_order = huge(1.0_wp)
+    quick_levels = 2; quick = .true.
     open(newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) then
       emsg = path//': cannot open: '//trim(msg); return
@@ -64,6 +67,7 @@ contains
     spec%nshape = count(shapes /= ''); spec%shapes = shapes
     spec%nscheme = count(schemes /= ''); spec%schemes = schemes
     spec%quick_levels = quick_levels; spec%quick = quick; spec%min_order = min_order
+    spec%max_order = max_order
     if (len_trim(benchmark) == 0) then
       emsg = path//': group &verify: key ''benchmark'': required'; return
     end if
@@ -78,9 +82,10 @@ contains
         emsg = path//': group &verify: key ''metrics'': at least one for study = ''matrix'''
         return
       end if
-      if (any(thresholds(1:spec%nmetric) < 0.0_wp)) then
-        emsg = path//': group &verify: key ''thresholds'': one non-negative threshold per '// &
-          'metric ('//str(spec%nmetric)//' expected)'; return
+      ! A negative threshold marks a metric that is reported, not asserted.
+      if (any(thresholds(1:spec%nmetric) == -huge(1.0_wp))) then
+        emsg = path//': group &verify: key ''thresholds'': one per metric ('// &
+          str(spec%nmetric)//' expected; -1 = reported only)'; return
       end if
     case ('space')
       spec%nlevel = count(levels > 0); spec%levels = levels
@@ -102,7 +107,7 @@ contains
       if (len_trim(spec%metrics(1)) == 0) then
         emsg = path//': group &verify: key ''metrics'': the error measure of the study'; return
       end if
-      if (min_order < 0.0_wp) then
+      if (min_order == -huge(1.0_wp)) then
         emsg = path//': group &verify: key ''min_order'': required for a convergence study'
         return
       end if
