@@ -14,7 +14,8 @@ module empm_input
   use empm_loads, only: RAMP_NONE, RAMP_SINE
   use empm_particle_gen, only: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
   use empm_shape, only: shape_status_text
-  use empm_shape_factory, only: empm_shape_create, empm_shape_names
+  use empm_shape_factory, only: empm_shape_create, empm_shape_names, SHAPE_CREATE_BAD_PARAM
+  use empm_shape_lme, only: empm_shape_lme_t, LME_REMEDY_NONE, LME_REMEDY_ENLARGE
   use empm_material_factory, only: empm_material_create, material_status_text
   use empm_integrator_factory, only: empm_integrator_create, empm_integrator_names
   implicit none
@@ -89,14 +90,14 @@ contains
     case ('material'); keys = 'name model e nu density'
     case ('particles'); keys = 'material geometry lo hi center radius ppc placement velocity '// &
       'velocity_sine_amplitude velocity_sine_wavenumber velocity_sine_phase stress'
-    case ('shape'); keys = 'family'
+    case ('shape'); keys = 'family gamma tol0 remedy gamma_inside gamma_box_lo gamma_box_hi'
     case ('integrator'); keys = 'scheme cfl dt t_end max_steps newmark_gamma rho_b'
     case ('loads'); keys = 'gravity ramp ramp_time'
     case ('boundary'); keys = 'lo hi fix velocity'
     case ('probe'); keys = 'name particle point'
     case ('output'); keys = 'file history_every snapshot_times'
     case ('verify'); keys = 'benchmark study shapes schemes levels cfls metrics thresholds '// &
-      'min_order quick_levels quick'
+      'min_order max_order quick_levels quick'
     case default; keys = ''
     end select
   end function group_keys
@@ -305,23 +306,76 @@ contains
     type(empm_case_t), intent(inout) :: cs
     type(empm_overrides_t), intent(in) :: ov
     character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'family'
-    character(len=64) :: family
-    integer :: ios, info
+    character(len=*), parameter :: K = 'family, gamma, tol0, remedy, gamma_inside, '// &
+      'gamma_box_lo, gamma_box_hi'
+    character(len=64) :: family, remedy
+    real(wp) :: gamma, tol0, gamma_inside, gamma_box_lo(3), gamma_box_hi(3)
+    integer :: ios, info, nd
+    logical :: lme_keys
     character(len=512) :: msg
-    namelist /shape/ family
-    family = 'linear'
+    namelist /shape/ family, gamma, tol0, remedy, gamma_inside, gamma_box_lo, gamma_box_hi
+    family = 'linear'; gamma = UNSET; tol0 = UNSET; remedy = ''; gamma_inside = UNSET
+    gamma_box_lo = UNSET; gamma_box_hi = UNSET
+    nd = cs%model%grid%ndim
     rewind(u)
     read(u, nml=shape, iostat=ios, iomsg=msg)
     if (ios /= 0 .and. ios /= iostat_end) then
       emsg = nml_error(path, 'shape', K, msg); return
     end if
-    if (allocated(ov%shape)) family = ov%shape
-    call empm_shape_create(trim(lower(family)), cs%model%grid%ndim, cs%model%shape, info)
-    if (info /= 0) then
-      emsg = req(path, 'shape', 'family', 'unknown family '''//trim(family)// &
-        '''; expected one of: '//empm_shape_names()); return
+    ! LME keys with another family are an error, unless the family is overridden.
+    lme_keys = gamma /= UNSET .or. tol0 /= UNSET .or. len_trim(remedy) > 0 .or. &
+      gamma_inside /= UNSET .or. any(gamma_box_lo /= UNSET) .or. any(gamma_box_hi /= UNSET)
+    if (lme_keys .and. .not. allocated(ov%shape)) then
+      if (index(lower(adjustl(family)), 'lme') /= 1) then
+        emsg = req(path, 'shape', 'family', 'keys gamma, tol0, remedy and gamma_* apply to '// &
+          'family ''lme'' only, got '''//trim(family)//''''); return
+      end if
     end if
+    if (allocated(ov%shape)) family = ov%shape
+    if (gamma == UNSET) gamma = 3.0_wp
+    if (tol0 == UNSET) tol0 = 1.0e-6_wp
+    if (.not. (gamma > 0.0_wp)) then
+      emsg = req(path, 'shape', 'gamma', 'expected gamma > 0, got '//str(gamma)); return
+    end if
+    if (.not. (tol0 > 0.0_wp .and. tol0 < 1.0_wp)) then
+      emsg = req(path, 'shape', 'tol0', 'expected 0 < tol0 < 1, got '//str(tol0)); return
+    end if
+    call empm_shape_create(trim(lower(family)), nd, cs%model%shape, info, gamma, tol0)
+    if (info == SHAPE_CREATE_BAD_PARAM) then
+      emsg = req(path, 'shape', 'family', 'expected gamma > 0 in '''//trim(family)//''''); return
+    else if (info /= 0) then
+      emsg = req(path, 'shape', 'family', 'unknown family '''//trim(family)// &
+        '''; expected one of: '//empm_shape_names()//' (or lme_g<gamma>)'); return
+    end if
+    select type (s => cs%model%shape)
+    type is (empm_shape_lme_t)
+      select case (trim(lower(remedy)))
+      case ('', 'none'); s%remedy = LME_REMEDY_NONE
+      case ('enlarge'); s%remedy = LME_REMEDY_ENLARGE
+      case default
+        emsg = req(path, 'shape', 'remedy', 'expected ''none'' or ''enlarge'', got '''// &
+          trim(remedy)//''''); return
+      end select
+      if (gamma_inside /= UNSET) then
+        if (.not. (gamma_inside > 0.0_wp)) then
+          emsg = req(path, 'shape', 'gamma_inside', 'expected > 0, got '//str(gamma_inside))
+          return
+        end if
+        if (any(gamma_box_lo(1:nd) == UNSET) .or. any(gamma_box_hi(1:nd) == UNSET)) then
+          emsg = req(path, 'shape', 'gamma_box_lo/hi', 'required with gamma_inside: '// &
+            str(nd)//' coordinates each [m]'); return
+        end if
+        if (any(gamma_box_hi(1:nd) < gamma_box_lo(1:nd))) then
+          emsg = req(path, 'shape', 'gamma_box_hi', 'expected hi >= lo in every direction')
+          return
+        end if
+        call s%set_gamma_box(cs%model%grid, gamma_box_lo(1:nd), gamma_box_hi(1:nd), &
+                             gamma_inside, info)
+      else if (any(gamma_box_lo /= UNSET) .or. any(gamma_box_hi /= UNSET)) then
+        emsg = req(path, 'shape', 'gamma_inside', 'required with gamma_box_lo/hi: the gamma '// &
+          'of the nodes in the box'); return
+      end if
+    end select
     cs%shape_name = cs%model%shape%name()
   end subroutine read_shape
 

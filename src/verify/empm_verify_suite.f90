@@ -284,7 +284,7 @@ contains
         end do
         n = count(done(a:b))
         hs = pack(hval(a:b), done(a:b)); es = pack(values(1, a:b), done(a:b))
-        ok = n >= 2 .and. all(es > 0.0_wp .and. es < huge(1.0_wp))
+        ok = n >= 2 .and. all(es > 0.0_wp .and. es < huge(1.0_wp)) .and. all(hs > 0.0_wp)
         order = 0.0_wp
         if (ok) then
           p = observed_orders(hs, es)
@@ -304,7 +304,7 @@ contains
         call jc%key('values'); call jc%real_array(hs)
         call jc%key('errors'); call jc%real_array(es)
         call jc%key('observed_order'); call jc%real_value(order)
-        if (n >= 2) then
+        if (ok .or. (n >= 2 .and. all(es > 0.0_wp .and. es < huge(1.0_wp)))) then
           call jc%key('fitted_order'); call jc%real_value(fitted_order(hs, es))
         end if
         call jc%key('min_order'); call jc%real_value(specs(runs(a)%spec)%min_order)
