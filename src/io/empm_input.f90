@@ -97,7 +97,7 @@ contains
     case ('probe'); keys = 'name particle point'
     case ('output'); keys = 'file history_every snapshot_times'
     case ('verify'); keys = 'benchmark study shapes schemes levels cfls metrics thresholds '// &
-      'min_order max_order quick_levels quick'
+      'min_order max_order expect_fail quick_levels quick'
     case default; keys = ''
     end select
   end function group_keys

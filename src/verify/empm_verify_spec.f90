@@ -26,6 +26,7 @@ module empm_verify_spec
     real(wp) :: min_order = 0.0_wp               !! convergence study: required order
     real(wp) :: max_order = huge(1.0_wp)         !! convergence study: order must stay below
                                                  !! (to assert a known loss of convergence)
+    character(len=64) :: expect_fail(MAXLIST) = '' !! run-id patterns expected to fail a check
     integer :: quick_levels = 2                  !! convergence levels run in quick mode
     logical :: quick = .true.                    !! included in the quick subset
   end type empm_verify_spec_t
@@ -38,20 +39,21 @@ contains
     type(empm_verify_spec_t), intent(out) :: spec            !! the study
     character(len=:), allocatable, intent(out) :: emsg       !! '' or the problem
     character(len=*), parameter :: K = 'benchmark, study, shapes, schemes, levels, cfls, '// &
-      'metrics, thresholds, min_order, max_order, quick_levels, quick'
+      'metrics, thresholds, min_order, max_order, expect_fail, quick_levels, quick'
     character(len=32) :: benchmark, metrics(MAXLIST)
+    character(len=64) :: expect_fail(MAXLIST)
     character(len=16) :: study, shapes(MAXLIST), schemes(MAXLIST)
     integer :: levels(MAXLIST), quick_levels, u, ios
     real(wp) :: cfls(MAXLIST), thresholds(MAXLIST), min_order, max_order
     logical :: quick
     character(len=512) :: msg
     namelist /verify/ benchmark, study, shapes, schemes, levels, cfls, metrics, thresholds, &
-      min_order, max_order, quick_levels, quick
+      min_order, max_order, expect_fail, quick_levels, quick
     emsg = ''
     spec%file = path
     benchmark = ''; study = 'matrix'; shapes = ''; schemes = ''; levels = 0; cfls = 0.0_wp
     metrics = ''; thresholds = -huge(1.0_wp); min_order = -huge(1.0_wp); max_order = huge(1.0_wp)
-    quick_levels = 2; quick = .true.
+    quick_levels = 2; quick = .true.; expect_fail = ''
     open(newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) then
       emsg = path//': cannot open: '//trim(msg); return
@@ -67,7 +69,7 @@ contains
     spec%nshape = count(shapes /= ''); spec%shapes = shapes
     spec%nscheme = count(schemes /= ''); spec%schemes = schemes
     spec%quick_levels = quick_levels; spec%quick = quick; spec%min_order = min_order
-    spec%max_order = max_order
+    spec%max_order = max_order; spec%expect_fail = expect_fail
     if (len_trim(benchmark) == 0) then
       emsg = path//': group &verify: key ''benchmark'': required'; return
     end if
