@@ -4,7 +4,7 @@
 !> Definitions: ../shared/docs/algorithms.md §3; metrics: docs/verification.md.
 module empm_verify_bench
   use hdf5, only: h5open_f, h5fopen_f, h5fclose_f, H5F_ACC_RDWR_F
-  use empm_kinds, only: wp
+  use empm_kinds, only: wp, pi
   use empm_strings, only: str
   use empm_case, only: empm_case_t
   use empm_history, only: empm_history_t
@@ -129,24 +129,29 @@ contains
       call expect_speed(self%column%wave_speed())
       self%sscale = self%column%rho * self%column%g * self%column%H
       self%uscale = self%column%settlement()
-      self%vscale = self%uscale * 2.0_wp * acos(-1.0_wp) / self%column%period()
+      self%vscale = self%uscale * 2.0_wp * pi / self%column%period()
     case ('mms_linear_1d')
       call expect_speed(sqrt(self%ml1%modulus() / self%ml1%rho))
       call set_initial_state(cs)
       allocate(cs%model%loads%body_force, source=self%ml1)
-      self%uscale = self%ml1%A
+      self%uscale = self%ml1%A; self%vscale = self%ml1%A * 2.0_wp * pi / self%ml1%period
+      self%sscale = self%ml1%E * self%ml1%A * 2.0_wp * pi / self%ml1%L
     case ('mms_linear_2d')
       call set_initial_state(cs)
       allocate(cs%model%loads%body_force, source=self%ml2)
-      self%uscale = self%ml2%A
+      self%uscale = self%ml2%A; self%vscale = self%ml2%A * 2.0_wp * pi / self%ml2%period
+      self%sscale = self%ml2%E * self%ml2%A * pi / self%ml2%L
     case ('mms_neohookean_1d')
       call set_initial_state(cs)
       allocate(cs%model%loads%body_force, source=self%nh1)
       self%uscale = self%nh1%A
+      self%vscale = self%nh1%A * pi * sqrt(self%nh1%E / self%nh1%rho0) / self%nh1%L
+      self%sscale = self%nh1%E * self%nh1%A * 2.0_wp * pi / self%nh1%L
     case ('mms_axis_aligned_2d')
       call set_initial_state(cs)
       allocate(cs%model%loads%body_force, source=self%aa2)
-      self%uscale = self%aa2%A
+      self%uscale = self%aa2%A; self%vscale = self%aa2%A * pi * sqrt(self%aa2%E / self%aa2%rho0)
+      self%sscale = self%aa2%E * self%aa2%A * 2.0_wp * pi / self%aa2%L
     case ('colliding_disks')
     case default
       emsg = 'unknown benchmark '''//trim(id)//'''; known: '//KNOWN

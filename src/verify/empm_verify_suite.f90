@@ -199,7 +199,11 @@ contains
                      bref, ran, msg)
         if (.not. ran) write(error_unit, '(a)') '  reference run failed: '//msg
         np = cref%model%pts%np
-        ref_u = cref%model%pts%x(:, 1:np) - cref%model%pts%x0(:, 1:np)
+        if (trim(spec%metrics(1)) == 'velocity_l2') then
+          ref_u = cref%model%pts%v(:, 1:np)
+        else
+          ref_u = cref%model%pts%x(:, 1:np) - cref%model%pts%x0(:, 1:np)
+        end if
       end if
       if (spec%study == 'time') ov%cfl = spec%cfls(r%ilevel)
       out = outdir//'/raw/'//flat(r%id)//'.h5'
@@ -208,7 +212,10 @@ contains
       if (spec%study == 'time') hlevel = spec%cfls(r%ilevel)
       if (spec%study == 'time' .and. ran) then
         np = cs%model%pts%np
-        if (allocated(ref_u)) then
+        if (allocated(ref_u) .and. trim(spec%metrics(1)) == 'velocity_l2') then
+          val(1) = weighted_l2(cs%model%pts%vol0(1:np), cs%model%pts%v(:, 1:np), ref_u) / &
+                   bench%vscale
+        else if (allocated(ref_u)) then
           val(1) = weighted_l2(cs%model%pts%vol0(1:np), cs%model%pts%x(:, 1:np) - &
                                cs%model%pts%x0(:, 1:np), ref_u) / bench%uscale
         else
@@ -312,7 +319,7 @@ contains
         call jc%key('parameter'); call jc%str_value(merge('h  ', 'cfl', &
           specs(runs(a)%spec)%study == 'space'))
         if (specs(runs(a)%spec)%study == 'time') then
-          call jc%key('metric'); call jc%str_value('temporal_displacement_l2')
+          call jc%key('metric'); call jc%str_value('temporal_'//trim(specs(runs(a)%spec)%metrics(1)))
         else
           call jc%key('metric'); call jc%str_value(trim(specs(runs(a)%spec)%metrics(1)))
         end if
