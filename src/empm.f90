@@ -16,6 +16,8 @@ module empm
   use empm_particle_gen, only: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
   use empm_shape, only: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK
   use empm_shape_factory, only: empm_shape_create, empm_shape_names
+  use empm_shape_lme, only: empm_shape_lme_t, LME_REMEDY_NONE, LME_REMEDY_ENLARGE
+  use empm_lme_legacy, only: empm_lme_basis
   use empm_material, only: empm_material_t
   use empm_material_factory, only: empm_material_create, material_status_text
   use empm_loads, only: empm_loads_t, empm_body_force_t, RAMP_NONE, RAMP_SINE
@@ -40,6 +42,7 @@ module empm
   public :: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
   public :: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK
   public :: empm_shape_create, empm_shape_names
+  public :: empm_shape_lme_t, LME_REMEDY_NONE, LME_REMEDY_ENLARGE, empm_lme_basis
   ! Materials and loads
   public :: empm_material_t, empm_material_create, material_status_text
   public :: empm_loads_t, empm_body_force_t, RAMP_NONE, RAMP_SINE

@@ -712,12 +712,20 @@ contains
     character(len=*), intent(in) :: path
     type(empm_case_t), intent(inout) :: cs
     character(len=:), allocatable, intent(inout) :: emsg
-    integer :: ibad, info
+    integer :: ibad, info, d
+    character(len=:), allocatable :: xs
     call cs%model%finalize_setup()
     call cs%model%shape%eval_batch(cs%model%grid, cs%model%pts, cs%model%basis, ibad, info)
     if (info /= 0) then
+      xs = ''
+      if (ibad >= 1 .and. ibad <= cs%model%pts%np) then
+        do d = 1, cs%model%grid%ndim
+          xs = xs//merge(' (', ', ', d == 1)//str(cs%model%pts%x(d, ibad))
+        end do
+        xs = ' at x ='//xs//')'
+      end if
       emsg = path//': groups &grid/&particles/&shape are inconsistent: at particle '// &
-        str(ibad)//' the '//cs%shape_name//' shape functions fail: '//shape_status_text(info)
+        str(ibad)//xs//' the '//cs%shape_name//' shape functions fail: '//shape_status_text(info)
     end if
   end subroutine check_initial_basis
 end module empm_input
