@@ -293,7 +293,7 @@ contains
       integer :: a, b, n, k
       real(wp), allocatable :: hs(:), es(:), p(:)
       real(wp) :: order
-      logical :: ok
+      logical :: ok, expected, within
       a = 1
       do while (a <= nrun)
         if (len(runs(a)%group) == 0 .or. .not. done(a)) then
@@ -313,9 +313,22 @@ contains
           order = p(size(p))
           ok = order >= specs(runs(a)%spec)%min_order .and. order <= specs(runs(a)%spec)%max_order
         end if
+        ! A documented known failure passes the check when its runs completed and its order
+        ! misses the bounds.
+        expected = .false.
+        do k = 1, size(specs(runs(a)%spec)%expect_fail)
+          if (len_trim(specs(runs(a)%spec)%expect_fail(k)) > 0) then
+            if (empm_glob_match(trim(specs(runs(a)%spec)%expect_fail(k)), runs(a)%group)) &
+              expected = .true.
+          end if
+        end do
+        within = ok
+        if (expected) ok = .not. ok .and. n >= 2 .and. all(es < huge(1.0_wp))
         if (.not. ok) nfail = nfail + 1
         call jc%begin_object()
         call jc%key('id'); call jc%str_value(runs(a)%group)
+        call jc%key('expected_failure'); call jc%bool_value(expected)
+        call jc%key('within_bounds'); call jc%bool_value(within)
         call jc%key('parameter'); call jc%str_value(merge('h  ', 'cfl', &
           specs(runs(a)%spec)%study == 'space'))
         if (specs(runs(a)%spec)%study == 'time') then
@@ -340,7 +353,8 @@ contains
         end do
         call jc%end_array()
         call jc%end_object()
-        write(output_unit, '(a)') merge('pass ', 'FAIL ', ok)//runs(a)%group//': errors '// &
+        write(output_unit, '(a)') trim(merge('pass ', 'FAIL ', ok))// &
+          trim(merge(' (known failure)', '                ', expected))//' '//runs(a)%group//': errors '// &
           join(es)//' observed order '//str(order)//' (>= '// &
           str(specs(runs(a)%spec)%min_order)//')'
         a = b + 1
