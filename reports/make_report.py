@@ -1,0 +1,266 @@
+#!/usr/bin/python3
+"""Write reports/README.md and its figures from reports/summary.json and the raw HDF5 results.
+
+Run after `empm verify` (scripts/run does both). Uses Debian's python3-numpy, python3-h5py and
+python3-matplotlib, so run it with /usr/bin/python3. Every number in the report comes from
+summary.json or from the HDF5 files it names.
+"""
+import json
+import os
+import sys
+
+import h5py
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import numpy as np  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ROOT = os.path.dirname(HERE)
+FIG = os.path.join(HERE, "figures")
+SCHEMES = ["usl", "musl", "gen_alpha", "pc_published", "pc_newmark"]
+
+
+def h5(path):
+    return h5py.File(path if os.path.isabs(path) else os.path.join(ROOT, path), "r")
+
+
+def fmt(x):
+    return "n/a" if x is None else f"{x:.3g}"
+
+
+def savefig(fig, name):
+    fig.tight_layout()
+    fig.savefig(os.path.join(FIG, name), dpi=100)
+    plt.close(fig)
+    return f"figures/{name}"
+
+
+def result(c):
+    if c.get("expected_failure"):
+        return "pass (known failure)" if c["passed"] else "**FAIL** (expected to fail)"
+    return "pass" if c["passed"] else "**FAIL**"
+
+
+def summary_table(s):
+    rows = ["| check | metric | value | threshold | result |", "|---|---|---|---|---|"]
+    for c in s["cases"]:
+        for m, v in c["metrics"].items():
+            t = c["thresholds"].get(m)
+            rows.append(f"| `{c['id']}` | {m} | {fmt(v)} | "
+                        f"{'reported' if t is None else '≤ ' + fmt(t)} | "
+                        f"{result(c) if t is not None else '–'} |")
+    for c in s["convergence"]:
+        bound = f"≥ {fmt(c['min_order'])}" if c["min_order"] > -99 else ""
+        if "max_order" in c:
+            bound += (", " if bound else "") + f"≤ {fmt(c['max_order'])}"
+        rows.append(f"| `{c['id']}` | order of {c['metric']} | {fmt(c['observed_order'])} | "
+                    f"{bound} | {result(c)} |")
+    return "\n".join(rows)
+
+
+def by_bench(s, bench):
+    return ([c for c in s["cases"] if c["id"].split("/")[0] == bench],
+            [c for c in s["convergence"] if c["id"].split("/")[0] == bench])
+
+
+def convergence_section(conv, name, title):
+    if not conv:
+        return []
+    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    rows = ["| study | values | errors | observed orders | fitted | bounds | result |",
+            "|---|---|---|---|---|---|---|"]
+    for c in conv:
+        h, e = np.array(c["values"]), np.array(c["errors"])
+        ok = np.all(np.isfinite(e)) and np.all(e > 0) and np.all(e < 1e300)
+        if ok:
+            ax.loglog(h, e, "o-", label=f"{'/'.join(c['id'].split('/')[1:])} "
+                                        f"({c['observed_order']:.2f})")
+            orders = np.log(e[:-1] / e[1:]) / np.log(h[:-1] / h[1:])
+        else:
+            orders = []
+        bound = f"≥ {fmt(c['min_order'])}" if c["min_order"] > -99 else ""
+        if "max_order" in c:
+            bound += (", " if bound else "") + f"≤ {fmt(c['max_order'])}"
+        rows.append(f"| `{c['id']}` | {', '.join(fmt(x) for x in h)} | "
+                    f"{', '.join(fmt(x) for x in e)} | {', '.join(f'{o:.2f}' for o in orders)} | "
+                    f"{fmt(c.get('fitted_order'))} | {bound} | {result(c)} |")
+    ax.set_xlabel(conv[0]["parameter"].strip())
+    ax.set_ylabel(conv[0]["metric"])
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=6)
+    ax.set_title(title)
+    return [f"![{title}]({savefig(fig, name)})", "", *rows, ""]
+
+
+def dyka_section(s):
+    cases, conv = by_bench(s, "dyka")
+    if not cases:
+        return []
+    out = ["## Dyka bar (paper section 6.1)", "",
+           "Free-end velocity and last-quarter stress against the exact solution by "
+           "characteristics (one panel per integrator, as the paper's figures 5–9; black: exact). "
+           "40 cells, 1 particle per cell, CFL 0.5, T = 2e-4 s.", ""]
+    shapes = sorted({c["id"].split("/")[2] for c in cases}, key=lambda x: (x[0] != "l", x))
+    for probe, label, scale, fname in [("free_end", "free-end velocity [m/s]", 1.0, "v"),
+                                       ("last_quarter", "stress in the last quarter [MPa]",
+                                        1e-6, "stress")]:
+        fig, axes = plt.subplots(len(SCHEMES), 1, figsize=(8, 2.1 * len(SCHEMES)), sharex=True)
+        for ax, sch in zip(axes, SCHEMES):
+            exact_done = False
+            for c in cases:
+                b, cs, shp = c["id"].split("/")
+                if cs != sch:
+                    continue
+                with h5(c["output"]) as f:
+                    t = f[f"/probes/{probe}/time"][:] * 1e6
+                    y = f[f"/probes/{probe}/{fname}"][:, 0] * scale
+                    if not exact_done:
+                        ye = f[f"/verification/probe_{probe}/{fname}"][:, 0] * scale
+                        ax.plot(t, ye, "k-", lw=1.5, label="exact")
+                        exact_done = True
+                ax.plot(t, y, lw=0.8, label=shp)
+            ax.set_title(sch, fontsize=9)
+            ax.set_ylabel(label, fontsize=7)
+            ax.grid(alpha=0.3)
+        axes[0].legend(fontsize=6, ncol=4)
+        axes[-1].set_xlabel("time [µs]")
+        out += [f"![Dyka {probe}]({savefig(fig, f'dyka_{probe}.png')})", ""]
+    # Metric table: scheme x shape
+    metrics = ["rms_velocity", "history_l2_velocity", "history_l2_stress", "noise_share"]
+    for m in metrics:
+        out += [f"**{m}**", "", "| scheme | " + " | ".join(shapes) + " |",
+                "|---|" + "---|" * len(shapes)]
+        for sch in SCHEMES:
+            row = [sch]
+            for shp in shapes:
+                c = next((c for c in cases if c["id"] == f"dyka/{sch}/{shp}"), None)
+                row.append(fmt(c["metrics"].get(m)) if c else "")
+            out.append("| " + " | ".join(row) + " |")
+        out.append("")
+    # The paper's claim: does the predictor-corrector reduce spurious oscillations?
+    def mean(sch, m):
+        v = [c["metrics"][m] for c in cases if c["id"].split("/")[1] == sch]
+        return np.mean(v) if v else np.nan
+    fe = np.nanmean([mean("usl", "noise_share"), mean("musl", "noise_share")])
+    fe_l2 = np.nanmean([mean("usl", "history_l2_velocity"), mean("musl", "history_l2_velocity")])
+    out += ["**The paper's claim, checked.** Averaged over the shape functions, the share of the "
+            f"free-end error energy above c/(8h) is {fe:.3f} for forward Euler (USL, MUSL), "
+            f"{mean('pc_published', 'noise_share'):.3f} for the predictor-corrector as published "
+            f"and {mean('pc_newmark', 'noise_share'):.3f} for its Newmark-consistent form "
+            f"({mean('gen_alpha', 'noise_share'):.3f} for generalized-α); the L2 error of the "
+            f"free-end history is {fe_l2:.3f} v0 (forward Euler), "
+            f"{mean('pc_published', 'history_l2_velocity'):.3f} v0 (pc_published) and "
+            f"{mean('pc_newmark', 'history_l2_velocity'):.3f} v0 (pc_newmark). The published "
+            "update damps the high frequencies (it is first order in time, see the temporal "
+            "studies below): it removes overshoot at the price of accuracy, while the "
+            "Newmark-consistent update keeps the central-difference behaviour of forward Euler.", ""]
+    out += convergence_section(conv, "dyka_convergence.png", "Dyka bar: mesh refinement")
+    return out
+
+
+def andersen_section(s):
+    cases, _ = by_bench(s, "andersen")
+    if not cases:
+        return []
+    out = ["## Andersen block (paper section 6.2)", "",
+           "Top-surface displacement history (the paper's figure 11), and σ_yy against depth at "
+           "t = 20 s with the exact column (static limit −ρg(H − Y)). 10 m × 10 m, h = 2 m, "
+           "4 particles per cell, gravity ramped by eq. (46) over 20 s, CFL 0.1.", ""]
+    fig, (a1, a2) = plt.subplots(1, 2, figsize=(11, 4.2))
+    for c in cases:
+        with h5(c["output"]) as f:
+            t = f["/probes/top/time"][:]
+            u = f["/probes/top/x"][:, 1] - f["/probes/top/x"][0, 1]
+            a1.plot(t, u, lw=0.9, label=f"{c['id'].split('/', 1)[1]}")
+            y0 = f["/final/x0"][:, 1]
+            sy = f["/final/stress"][:, 1] / 1e6
+            a2.plot(sy, y0, ".", ms=3, label=c["id"].split("/", 1)[1])
+            ye = np.linspace(0, 10, 50)
+    a2.plot(-6000 * 9.81 * (10 - ye) / 1e6, ye, "k-", lw=1.5, label="static exact")
+    a1.axhline(-0.5886, color="k", ls="--", lw=1, label="small-strain static")
+    a1.set_xlabel("t [s]"); a1.set_ylabel("top displacement [m]"); a1.grid(alpha=0.3)
+    a2.set_xlabel("σ_yy [MPa]"); a2.set_ylabel("Y (reference height) [m]"); a2.grid(alpha=0.3)
+    a1.legend(fontsize=6); a2.legend(fontsize=6)
+    out += [f"![Andersen block]({savefig(fig, 'andersen.png')})", ""]
+    stable = [c for c in cases if c["passed"] and not c.get("expected_failure")]
+    failed = [c for c in cases if c.get("expected_failure")]
+    out += ["**The paper's claim, checked.** Within the thresholds (stress profile and base stress "
+            "within 7 % of ρgH, settlement within 10 %, no growing vibration): "
+            + ", ".join(f"`{c['id']}`" for c in stable) + ". Bilinear (Q4) shape functions: "
+            + "; ".join(f"`{c['id']}` max speed {fmt(c['metrics']['max_speed'])}, profile error "
+                        f"{fmt(c['metrics']['profile_error'])}" for c in failed)
+            + ". The base stress is ρgH = 0.5886 MPa, not the paper's 5.2 MPa (erratum).", ""]
+    return out
+
+
+def disks_section(s):
+    cases, _ = by_bench(s, "colliding_disks")
+    if not cases:
+        return []
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for c in cases:
+        with h5(c["output"]) as f:
+            t = f["/history/time"][:]
+            e = f["/history/kinetic_energy"][:] + f["/history/strain_energy"][:]
+            ax.plot(t, e / e[0], lw=1, label=c["id"].split("/")[1])
+    ax.set_xlabel("t"); ax.set_ylabel("(kinetic + strain energy) / initial"); ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    return ["## Colliding disks (Sulsky et al. 1994)", "",
+            "Total energy history per integrator (linear shape functions, 20 × 20 cells, "
+            "4 particles per cell, CFL 0.1).", "",
+            f"![Colliding disks energy]({savefig(fig, 'colliding_disks_energy.png')})", ""]
+
+
+def main():
+    summary_path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(HERE, "summary.json")
+    with open(summary_path) as f:
+        s = json.load(f)
+    os.makedirs(FIG, exist_ok=True)
+    checks = [c for c in s["cases"] if any(t is not None for t in c["thresholds"].values())]
+    checks += s["convergence"]
+    nfail = sum(not c["passed"] for c in checks)
+    lines = ["# empm verification report", "",
+             f"empm {s['empm_version']}, generated {s['generated']}"
+             + (" (quick subset)" if s.get("quick") else "") + " by `scripts/run` "
+             "(`empm verify` + `reports/make_report.py`).", "",
+             f"**{len(checks) - nfail} of {len(checks)} checks passed.** Thresholds and "
+             "minimum orders, with their reasons, are in the case files in `verification/`; "
+             "known failures (asserted to fail, with the reason) are marked.", "",
+             "Raw results: `reports/raw/*.h5` (layout: docs/output.md, plus the group "
+             "`/verification` with the exact fields); machine-readable summary: "
+             "`reports/summary.json`.", ""]
+    lines += dyka_section(s)
+    for bench, title in [("vibrating_bar", "Vibrating bar"),
+                         ("mms_linear_1d", "Manufactured solution, small strain, 1D"),
+                         ("mms_linear_2d", "Manufactured solution, small strain, 2D"),
+                         ("mms_neohookean_1d", "Manufactured solution, neo-Hookean 1D (Steffen)"),
+                         ("mms_axis_aligned_2d",
+                          "Manufactured solution, axis-aligned 2D (Wallstedt & Guilkey)")]:
+        _, conv = by_bench(s, bench)
+        if conv:
+            lines += [f"## {title}", ""]
+            space = [c for c in conv if "/space/" in c["id"]]
+            time = [c for c in conv if "/time/" in c["id"]]
+            lines += convergence_section(space, f"{bench}_space.png", f"{title}: space")
+            lines += convergence_section(time, f"{bench}_time.png", f"{title}: time")
+    lines += andersen_section(s)
+    lines += disks_section(s)
+    extra = [("integrators/stability.png", "Integrator stability: spectral radius, damping, "
+              "period error (docs/integrators.md)"),
+             ("integrators/energy.png", "Energy histories per integrator"),
+             ("../docs/figures/lme_basis.png", "LME basis functions and derivatives "
+              "(docs/shape-functions.md)")]
+    present = [(p, t) for p, t in extra if os.path.exists(os.path.join(HERE, p))]
+    if present:
+        lines += ["## Integrator stability and LME basis", ""]
+        for p, t in present:
+            lines += [f"{t}:", "", f"![{t}]({p})", ""]
+    lines += ["## Summary of every check", "", summary_table(s), ""]
+    with open(os.path.join(HERE, "README.md"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+if __name__ == "__main__":
+    main()
