@@ -128,7 +128,8 @@ def dyka_section(s):
         axes[-1].set_xlabel("time [µs]")
         out += [f"![Dyka {probe}]({savefig(fig, f'dyka_{probe}.png')})", ""]
     # Metric table: scheme x shape
-    metrics = ["rms_velocity", "history_l2_velocity", "history_l2_stress", "noise_share"]
+    metrics = ["rms_velocity", "history_l2_velocity", "history_l2_stress", "noise_share",
+               "overshoot"]
     for m in metrics:
         out += [f"**{m}**", "", "| scheme | " + " | ".join(shapes) + " |",
                 "|---|" + "---|" * len(shapes)]
@@ -143,19 +144,32 @@ def dyka_section(s):
     def mean(sch, m):
         v = [c["metrics"][m] for c in cases if c["id"].split("/")[1] == sch]
         return np.mean(v) if v else np.nan
-    fe = np.nanmean([mean("usl", "noise_share"), mean("musl", "noise_share")])
-    fe_l2 = np.nanmean([mean("usl", "history_l2_velocity"), mean("musl", "history_l2_velocity")])
-    out += ["**The paper's claim, checked.** Averaged over the shape functions, the share of the "
-            f"free-end error energy above c/(8h) is {fe:.3f} for forward Euler (USL, MUSL), "
-            f"{mean('pc_published', 'noise_share'):.3f} for the predictor-corrector as published "
-            f"and {mean('pc_newmark', 'noise_share'):.3f} for its Newmark-consistent form "
-            f"({mean('gen_alpha', 'noise_share'):.3f} for generalized-α); the L2 error of the "
-            f"free-end history is {fe_l2:.3f} v0 (forward Euler), "
-            f"{mean('pc_published', 'history_l2_velocity'):.3f} v0 (pc_published) and "
-            f"{mean('pc_newmark', 'history_l2_velocity'):.3f} v0 (pc_newmark). The published "
-            "update damps the high frequencies (it is first order in time, see the temporal "
-            "studies below): it removes overshoot at the price of accuracy, while the "
-            "Newmark-consistent update keeps the central-difference behaviour of forward Euler.", ""]
+    def fe(m):
+        return np.nanmean([mean("usl", m), mean("musl", m)])
+
+    def hf(sch):
+        # RMS of the error above the cutoff: sqrt(share) x history L2 error.
+        v = [np.sqrt(c["metrics"]["noise_share"]) * c["metrics"]["history_l2_velocity"]
+             for c in cases if c["id"].split("/")[1] == sch]
+        return np.mean(v) if v else np.nan
+    hf_fe = np.nanmean([hf("usl"), hf("musl")])
+    out += ["**The paper's claim, checked: does the predictor-corrector reduce the spurious "
+            "oscillations relative to forward Euler, and by how much?** Averaged over the shape "
+            "functions, the peak free-end speed overshoots the exact v0 by "
+            f"{fe('overshoot'):.3f} v0 with forward Euler (USL, MUSL), "
+            f"{mean('pc_published', 'overshoot'):.3f} v0 with the predictor-corrector as "
+            f"published and {mean('pc_newmark', 'overshoot'):.3f} v0 with its Newmark-consistent "
+            f"form ({mean('gen_alpha', 'overshoot'):.3f} v0 with generalized-α). The RMS of the "
+            f"free-end error above c/(8h) is {hf_fe:.4f} v0 (forward Euler), "
+            f"{hf('pc_published'):.4f} v0 (pc_published), {hf('pc_newmark'):.4f} v0 "
+            f"(pc_newmark); the L2 error of the whole history is {fe('history_l2_velocity'):.3f}, "
+            f"{mean('pc_published', 'history_l2_velocity'):.3f} and "
+            f"{mean('pc_newmark', 'history_l2_velocity'):.3f} v0. So yes for the published "
+            "scheme — it removes the overshoot — but by numerical damping: it is first order in "
+            "time (temporal studies below) and rounds the pulses off; the Newmark-consistent "
+            "update, second order, oscillates like forward Euler. The paper attributes the "
+            "smoothing to the predictor-corrector idea; our measurements attribute it to the "
+            "published particle update's dissipation.", ""]
     out += convergence_section(conv, "dyka_convergence.png", "Dyka bar: mesh refinement")
     return out
 

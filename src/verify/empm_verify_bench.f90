@@ -224,7 +224,7 @@ contains
         value = weighted_l2(pts%vol0(1:np), pts%x(:, 1:np) - pts%x0(:, 1:np), ue) / self%uscale
       case ('stress_l2')
         value = weighted_l2(pts%vol0(1:np), pts%stress(:, 1:np), se) / self%sscale
-      case ('history_l2_velocity', 'noise_share', 'history_l2_stress')
+      case ('history_l2_velocity', 'noise_share', 'history_l2_stress', 'overshoot')
         k = merge(2, 1, trim(name) == 'history_l2_stress')
         if (hist%nprobe < k) then
           emsg = trim(name)//' needs probe '//str(k)//' in the case file'; return
@@ -232,6 +232,9 @@ contains
         call probe_exact(k, pv, ps)
         if (trim(name) == 'history_l2_velocity') then
           value = history_l2(hist%t(1:hist%nt), hist%pv(1, k, 1:hist%nt), pv) / self%vscale
+        else if (trim(name) == 'overshoot') then
+          ! Peak velocity beyond the exact peak at the probe, relative to the velocity scale.
+          value = (maxval(abs(hist%pv(1, k, 1:hist%nt))) - maxval(abs(pv))) / self%vscale
         else if (trim(name) == 'history_l2_stress') then
           value = history_l2(hist%t(1:hist%nt), hist%ps(1, k, 1:hist%nt), ps) / self%sscale
         else
