@@ -4,13 +4,17 @@ program empm_main
   use empm, only: empm_version, empm_run_case, empm_error_t
   use empm_terminal, only: empm_exit
   use empm_files, only: empm_mkdir_p
+  use empm_kinds, only: wp
   use empm_verify_suite, only: empm_verify_run
+  use empm_bench, only: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json
   implicit none
   integer :: nargs, i, ios, nfail, npat
   character(len=:), allocatable :: cmd, case_file, out_file, written, manifest, outdir
   character(len=256), allocatable :: patterns(:)
   logical :: quick
   type(empm_error_t) :: err
+  type(empm_bench_config_t) :: bcfg
+  type(empm_bench_result_t) :: bres
 
   nargs = command_argument_count()
   if (nargs == 0) then
@@ -73,6 +77,30 @@ program empm_main
       call empm_exit(err%code)
     end if
     if (nfail > 0) call empm_exit(5)
+  case ('bench')
+    i = 2
+    do while (i <= nargs)
+      if (i == nargs) call die('option '//arg(i)//' needs a value')
+      select case (arg(i))
+      case ('--dim');        bcfg%dim = int_arg(i)
+      case ('--shape');      bcfg%shape = arg(i + 1)
+      case ('--gamma');      bcfg%gamma = real_arg(i)
+      case ('--cells');      bcfg%cells = int_arg(i)
+      case ('--ppc');        bcfg%ppc = int_arg(i)
+      case ('--steps');      bcfg%steps = int_arg(i)
+      case ('--warmup');     bcfg%warmup = int_arg(i)
+      case ('--threads');    bcfg%threads = int_arg(i)
+      case ('--integrator'); bcfg%integrator = arg(i + 1)
+      case default;          call die('unknown option '//arg(i))
+      end select
+      i = i + 2
+    end do
+    call empm_bench_run(bcfg, bres, err)
+    if (err%code /= 0) then
+      write(error_unit, '(a)') 'empm: error: '//err%message
+      call empm_exit(err%code)
+    end if
+    write(output_unit, '(a)') empm_bench_json(bres)
   case default
     call die('unknown command '''//cmd//'''')
   end select
@@ -88,6 +116,25 @@ contains
     call get_command_argument(k, s)
   end function arg
 
+  ! Value of option k (argument k + 1) as an integer / a real; a usage error otherwise.
+  integer function int_arg(k) result(v)
+    integer, intent(in) :: k
+    integer :: ios
+    character(len=:), allocatable :: text
+    text = arg(k + 1)
+    read(text, *, iostat=ios) v
+    if (ios /= 0) call die('option '//arg(k)//' needs an integer, got '''//arg(k + 1)//'''')
+  end function int_arg
+
+  real(wp) function real_arg(k) result(v)
+    integer, intent(in) :: k
+    integer :: ios
+    character(len=:), allocatable :: text
+    text = arg(k + 1)
+    read(text, *, iostat=ios) v
+    if (ios /= 0) call die('option '//arg(k)//' needs a number, got '''//arg(k + 1)//'''')
+  end function real_arg
+
   subroutine die(msg)
     character(len=*), intent(in) :: msg
     write(error_unit, '(a)') 'empm: '//msg//' (see empm --help)'
@@ -98,6 +145,8 @@ contains
     integer, intent(in) :: u
     write(u, '(a)') 'usage: empm run CASE.nml [-o OUT.h5]'
     write(u, '(a)') '       empm verify [PATTERN...] [--quick] [--out DIR] [--manifest FILE]'
+    write(u, '(a)') '       empm bench [--dim 2|3] [--shape S] [--gamma G] [--cells N] [--ppc P] [--steps K]'
+    write(u, '(a)') '                  [--threads T] [--integrator I] [--warmup W]'
     write(u, '(a)') '       empm --help | --version'
     write(u, '(a)') ''
     write(u, '(a)') 'Runs an explicit MPM simulation described by a namelist case file'
@@ -108,6 +157,9 @@ contains
     write(u, '(a)') '(or --manifest), only the runs whose id matches a PATTERN (* wildcard, e.g.'
     write(u, '(a)') '''dyka/*''), writes DIR/raw/*.h5 and DIR/summary.json (default DIR: reports)'
     write(u, '(a)') 'and exits with status 5 when a check fails. --quick: coarse levels only.'
+    write(u, '(a)') ''
+    write(u, '(a)') 'empm bench times a freely vibrating elastic block (N^dim cells, P particles per'
+    write(u, '(a)') 'cell) and prints one JSON object (docs/performance.md).'
     write(u, '(a)') ''
     write(u, '(a)') 'exit status: 0 success, 1 usage error, 2 invalid case file,'
     write(u, '(a)') '             3 run stopped by a guard (results marked incomplete), 4 I/O error,'

@@ -6,7 +6,7 @@ module empm_tensor
   use empm_kinds, only: wp
   implicit none
   private
-  public :: identity3, trace3, det3, sym3, voigt_to_mat, mat_to_voigt, voigt_ddot
+  public :: identity3, trace3, det3, sym3, voigt_to_mat, mat_to_voigt, voigt_ddot, advance_f
 
 contains
 
@@ -67,4 +67,19 @@ contains
     voigt_ddot = a(1) * b(1) + a(2) * b(2) + a(3) * b(3) &
                + 2.0_wp * (a(4) * b(4) + a(5) * b(5) + a(6) * b(6))
   end function voigt_ddot
+
+  !> Deformation gradient after a step with constant velocity gradient L (first order):
+  !> (I + Δt L) F, written out so that no temporary is allocated per particle.
+  pure function advance_f(dt, L, F) result(Fn)
+    real(wp), intent(in) :: dt       !! time step [s]
+    real(wp), intent(in) :: L(3,3)   !! velocity gradient [1/s]
+    real(wp), intent(in) :: F(3,3)   !! deformation gradient at the start of the step
+    real(wp) :: Fn(3,3)              !! deformation gradient at the end of the step
+    integer :: i, j
+    do j = 1, 3
+      do i = 1, 3
+        Fn(i,j) = F(i,j) + dt * (L(i,1) * F(1,j) + L(i,2) * F(2,j) + L(i,3) * F(3,j))
+      end do
+    end do
+  end function advance_f
 end module empm_tensor

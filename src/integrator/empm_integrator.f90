@@ -4,11 +4,14 @@
 !> A scheme implements `step`, which advances the model by Δt. Adding a scheme means adding
 !> one file that extends [[empm_integrator_t]] and one line in [[empm_integrator_factory]].
 module empm_integrator
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_SHAPE_FAILED, &
                         STEP_MATERIAL_FAILED
   use empm_transfer, only: p2g_mass, p2g_internal_force, p2g_body_force, constrain_force, &
-                           nodal_divide_by_mass, g2p_value
+                           nodal_divide_by_mass, g2p_value, empm_p2g_work_t
+  use empm_timer, only: empm_phase_timer_t
+  use empm_parallel, only: empm_max_threads, EMPM_OMP_MIN_PARTICLES
   implicit none
   private
   public :: empm_integrator_t, eval_basis, update_stress, initial_acceleration
@@ -16,6 +19,8 @@ module empm_integrator
   !> Abstract explicit integrator. Work arrays are allocated once in `prepare`.
   type, abstract :: empm_integrator_t
     real(wp), allocatable :: bwork(:,:)  !! body-force scratch (ndim, np)
+    type(empm_p2g_work_t) :: p2g         !! per-thread P2G buffers (sized in `prepare`)
+    type(empm_phase_timer_t) :: timer    !! wall time per phase of the step, Newton iterations
   contains
     procedure(step_iface), deferred :: step
     procedure(name_iface), deferred :: name
@@ -52,6 +57,9 @@ contains
     if (allocated(self%bwork)) deallocate(self%bwork)
     allocate(self%bwork(model%grid%ndim, model%pts%np))
     self%bwork = 0.0_wp
+    ! Threads are fixed here: P2G sums depend on the chunking, so it must not change mid-run.
+    call self%p2g%init(model%grid%ndim, model%grid%nnode, model%pts%np, empm_max_threads())
+    call self%timer%reset()
     call self%start(model)
   end subroutine integrator_prepare
 
@@ -79,12 +87,20 @@ contains
     call g2p_value(model%basis, model%nodes%acc, model%pts%a)
   end subroutine initial_acceleration
 
-  !> Evaluate shape functions at the current particle positions (one batched call).
-  subroutine eval_basis(model, stat)
-    type(empm_model_t), intent(inout) :: model    !! simulation state
-    type(empm_step_status_t), intent(inout) :: stat !! set on failure
-    integer :: ibad, info
-    call model%shape%eval_batch(model%grid, model%pts, model%basis, ibad, info)
+  !> Evaluate shape functions at the current particle positions (one batched call). With
+  !> `timer`, Newton iterations of LME bases are counted in it.
+  subroutine eval_basis(model, stat, timer)
+    type(empm_model_t), intent(inout) :: model               !! simulation state
+    type(empm_step_status_t), intent(inout) :: stat          !! set on failure
+    type(empm_phase_timer_t), intent(inout), optional :: timer !! iteration counters
+    integer :: ibad, info, iters
+    if (present(timer)) then
+      call model%shape%eval_batch_iters(model%grid, model%pts, model%basis, ibad, info, iters)
+      timer%newton_iters = timer%newton_iters + iters
+      timer%basis_evals = timer%basis_evals + model%pts%np
+    else
+      call model%shape%eval_batch(model%grid, model%pts, model%basis, ibad, info)
+    end if
     if (info /= 0) then
       stat%code = STEP_SHAPE_FAILED; stat%detail = info; stat%particle = ibad
     end if
@@ -100,37 +116,55 @@ contains
     integer :: np, d
     np = model%pts%np; d = model%grid%ndim
     model%nodes%force = 0.0_wp
-    call p2g_internal_force(model%basis, model%pts%vol, model%pts%stress, model%nodes%force)
+    call p2g_internal_force(model%basis, model%pts%vol, model%pts%stress, model%nodes%force, &
+                            self%p2g)
     g = model%loads%gravity_at(t)
     if (allocated(model%loads%body_force)) then
       call model%loads%body_force%eval(t, model%pts%x0(:, 1:np), model%pts%x(:, 1:np), &
                                   self%bwork(:, 1:np))
       call p2g_body_force(model%basis, model%pts%m, g(1:d), self%bwork, .true., &
-                          model%nodes%force)
+                          model%nodes%force, self%p2g)
     else
       call p2g_body_force(model%basis, model%pts%m, g(1:d), self%bwork, .false., &
-                          model%nodes%force)
+                          model%nodes%force, self%p2g)
     end if
     call constrain_force(model%nodes, model%nodes%force)
   end subroutine assemble_forces
 
   !> Stress update of every particle from its velocity gradient `pts%L`, one batched call per
-  !> run of particles sharing a material; volumes follow from the updated densities.
+  !> run of particles sharing a material (with OpenMP, one call per thread on a slice of the
+  !> run: particles are independent); volumes follow from the updated densities.
   subroutine update_stress(model, dt, stat)
     type(empm_model_t), intent(inout) :: model      !! simulation state
     real(wp), intent(in) :: dt                      !! time step [s]
     type(empm_step_status_t), intent(inout) :: stat !! set on failure
-    integer :: r, i0, i1, info, im
+    integer :: r, i0, i1, info, im, n, nc, c, a, b, bad, p
     do r = 1, size(model%run_first)
       i0 = model%run_first(r); i1 = model%run_last(r)
       im = model%pts%mat(i0)
-      call model%mats(im)%model%update(dt, model%pts%L(:, :, i0:i1), model%pts%F(:, :, i0:i1), &
-        model%pts%strain(:, i0:i1), model%pts%stress(:, i0:i1), model%pts%rho(i0:i1), info)
-      if (info /= 0) then
-        stat%code = STEP_MATERIAL_FAILED; stat%detail = info; stat%particle = i0 + info - 1
+      n = i1 - i0 + 1
+      nc = 1
+      if (n >= EMPM_OMP_MIN_PARTICLES) nc = empm_max_threads()
+      ! The first failing particle of the run, whichever slice it is in.
+      bad = huge(1)
+      !$omp parallel do schedule(static, 1) private(a, b, info) reduction(min: bad) if(nc > 1)
+      do c = 0, nc - 1
+        a = i0 + int(int(n, int64) * c / nc); b = i0 + int(int(n, int64) * (c + 1) / nc) - 1
+        call model%mats(im)%model%update(dt, model%pts%L(:, :, a:b), model%pts%F(:, :, a:b), &
+          model%pts%strain(:, a:b), model%pts%stress(:, a:b), model%pts%rho(a:b), info)
+        if (info /= 0) bad = min(bad, a + info - 1)
+      end do
+      !$omp end parallel do
+      if (bad /= huge(1)) then
+        stat%code = STEP_MATERIAL_FAILED; stat%detail = bad - i0 + 1; stat%particle = bad
         return
       end if
     end do
-    model%pts%vol(1:model%pts%np) = model%pts%m(1:model%pts%np) / model%pts%rho(1:model%pts%np)
+    n = model%pts%np
+    !$omp parallel do schedule(static) if(n >= EMPM_OMP_MIN_PARTICLES)
+    do p = 1, n
+      model%pts%vol(p) = model%pts%m(p) / model%pts%rho(p)
+    end do
+    !$omp end parallel do
   end subroutine update_stress
 end module empm_integrator

@@ -14,6 +14,7 @@ module empm_integrator_euler
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: p2g_mass, p2g_weighted, g2p_add_scaled, g2p_value, &
                            velocity_gradient, nodal_divide_by_mass, constrain_velocity
+  use empm_timer, only: PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
   public :: empm_euler_t, EULER_USF, EULER_USL, EULER_MUSL
@@ -49,44 +50,56 @@ contains
     type(empm_model_t), intent(inout) :: model      !! simulation state
     real(wp), intent(in) :: dt                      !! time step [s]
     type(empm_step_status_t), intent(out) :: stat   !! outcome
-    associate (nodes => model%nodes, pts => model%pts, basis => model%basis)
-      call eval_basis(model, stat)
+    associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
+      call tm%mark()
+      call eval_basis(model, stat, tm)
+      call tm%lap(PHASE_SHAPE)
       if (stat%code /= STEP_OK) return
       call nodes%reset()
-      call p2g_mass(basis, pts%m, nodes%mass)
-      call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom)
+      call p2g_mass(basis, pts%m, nodes%mass, self%p2g)
+      call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom, self%p2g)
+      call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
       call constrain_velocity(nodes, nodes%vel, nodes%mom)
+      call tm%lap(PHASE_GRID)
 
       if (self%variant == EULER_USF) then
         call velocity_gradient(basis, nodes%vel, pts%L)
         call update_stress(model, dt, stat)
+        call tm%lap(PHASE_STRESS)
         if (stat%code /= STEP_OK) return
       end if
 
       call self%assemble_forces(model, model%t)
+      call tm%lap(PHASE_P2G)
       ! p^{k+1} = p^k + Δt f, then the constraints on the new nodal velocity.
       nodes%mom = nodes%mom + dt * nodes%force
       call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
       call constrain_velocity(nodes, nodes%vel, nodes%mom)
+      call tm%lap(PHASE_GRID)
 
       call g2p_value(basis, nodes%acc, pts%a)
       call g2p_add_scaled(basis, dt, nodes%acc, pts%v)
       call g2p_add_scaled(basis, dt, nodes%vel, pts%x)
+      call tm%lap(PHASE_G2P)
 
       select case (self%variant)
       case (EULER_USL)
         call velocity_gradient(basis, nodes%vel, pts%L)
         call update_stress(model, dt, stat)
+        call tm%lap(PHASE_STRESS)
       case (EULER_MUSL)
         ! Re-map momentum from the updated particle velocities (Sulsky's MUSL).
         nodes%mom = 0.0_wp
-        call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom)
+        call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom, self%p2g)
+        call tm%lap(PHASE_P2G)
         call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
         call constrain_velocity(nodes, nodes%vel, nodes%mom)
+        call tm%lap(PHASE_GRID)
         call velocity_gradient(basis, nodes%vel, pts%L)
         call update_stress(model, dt, stat)
+        call tm%lap(PHASE_STRESS)
       end select
     end associate
   end subroutine euler_step

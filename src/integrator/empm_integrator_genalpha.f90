@@ -15,6 +15,7 @@ module empm_integrator_genalpha
   use empm_transfer, only: p2g_mass, p2g_weighted, g2p_add_scaled, g2p_value, &
                            velocity_gradient, nodal_divide_by_mass, constrain_velocity, &
                            constrain_force
+  use empm_timer, only: PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
   public :: empm_genalpha_t, genalpha_parameters
@@ -65,33 +66,43 @@ contains
     type(empm_step_status_t), intent(out) :: stat   !! outcome
     real(wp) :: am, be, ga
     call genalpha_parameters(self%rho_b, am, be, ga)
-    associate (nodes => model%nodes, pts => model%pts, basis => model%basis)
-      call eval_basis(model, stat)
+    associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
+      call tm%mark()
+      call eval_basis(model, stat, tm)
+      call tm%lap(PHASE_SHAPE)
       if (stat%code /= STEP_OK) return
       call nodes%reset()
-      call p2g_mass(basis, pts%m, nodes%mass)
-      call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom)
+      call p2g_mass(basis, pts%m, nodes%mass, self%p2g)
+      call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom, self%p2g)
+      call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
       call constrain_velocity(nodes, nodes%vel, nodes%mom)
+      call tm%lap(PHASE_GRID)
       ! a_I^k in nodes%work (mass-weighted map of particle accelerations).
-      call p2g_weighted(basis, pts%m, pts%a, 0.0_wp, pts%a, nodes%acc)
+      call p2g_weighted(basis, pts%m, pts%a, 0.0_wp, pts%a, nodes%acc, self%p2g)
+      call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%acc, nodes%work)
       call constrain_force(nodes, nodes%work)
+      call tm%lap(PHASE_GRID)
       ! a_I^{k+1} in nodes%acc.
       call self%assemble_forces(model, model%t)
+      call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
       nodes%acc = (nodes%acc - am * nodes%work) / (1.0_wp - am)
       call constrain_force(nodes, nodes%acc)
+      call tm%lap(PHASE_GRID)
       ! Particle velocity from both accelerations; then Δu_I (reusing nodes%force).
       call g2p_add_scaled(basis, dt * (1.0_wp - ga), nodes%work, pts%v)
       call g2p_add_scaled(basis, dt * ga, nodes%acc, pts%v)
       nodes%force = dt * nodes%vel + dt * dt * ((0.5_wp - be) * nodes%work + be * nodes%acc)
       call g2p_add_scaled(basis, 1.0_wp, nodes%force, pts%x)
       call g2p_value(basis, nodes%acc, pts%a)
+      call tm%lap(PHASE_G2P)
       ! Strain with the nodal displacement actually applied: L = Σ (Δu_I/Δt) ⊗ ∇N.
       nodes%force = nodes%force / dt
       call velocity_gradient(basis, nodes%force, pts%L)
       call update_stress(model, dt, stat)
+      call tm%lap(PHASE_STRESS)
     end associate
   end subroutine ga_step
 end module empm_integrator_genalpha

@@ -15,8 +15,9 @@ module empm_integrator_pc
   use empm_kinds, only: wp
   use empm_integrator, only: empm_integrator_t, eval_basis, update_stress, initial_acceleration
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
-  use empm_transfer, only: p2g_mass, p2g_weighted, g2p_add_scaled, g2p_value, &
+  use empm_transfer, only: p2g_mass, p2g_weighted, g2p_add_scaled, g2p_value, g2p_pc_newmark, &
                            velocity_gradient, nodal_divide_by_mass, constrain_velocity
+  use empm_timer, only: PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
   public :: empm_pc_t, PC_PUBLISHED, PC_NEWMARK
@@ -62,22 +63,29 @@ contains
     type(empm_step_status_t), intent(out) :: stat   !! outcome
     real(wp) :: g
     g = self%gamma
-    associate (nodes => model%nodes, pts => model%pts, basis => model%basis)
-      call eval_basis(model, stat)
+    associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
+      call tm%mark()
+      call eval_basis(model, stat, tm)
+      call tm%lap(PHASE_SHAPE)
       if (stat%code /= STEP_OK) return
       call nodes%reset()
-      call p2g_mass(basis, pts%m, nodes%mass)
+      call p2g_mass(basis, pts%m, nodes%mass, self%p2g)
       ! Predictor, formed from particle data (eq. 31) to avoid dividing accelerations.
-      call p2g_weighted(basis, pts%m, pts%v, (1.0_wp - g) * dt, pts%a, nodes%mom)
+      call p2g_weighted(basis, pts%m, pts%v, (1.0_wp - g) * dt, pts%a, nodes%mom, self%p2g)
+      call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
       call constrain_velocity(nodes, nodes%vel, nodes%mom)
+      call tm%lap(PHASE_GRID)
       ! Strain increment and stress with the predicted velocity.
       call velocity_gradient(basis, nodes%vel, pts%L)
       call update_stress(model, dt, stat)
+      call tm%lap(PHASE_STRESS)
       if (stat%code /= STEP_OK) return
       ! Balance of forces at t + Δt; nodes%acc = f/m (zero on fixed dofs).
       call self%assemble_forces(model, model%t + dt)
+      call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
+      call tm%lap(PHASE_GRID)
 
       if (self%variant == PC_PUBLISHED) then
         ! Corrector v_I = v* + γΔt a_I into the scratch array; eqs. (33)–(35).
@@ -87,13 +95,11 @@ contains
         call g2p_value(basis, nodes%acc, pts%a)
         pts%v(:, 1:pts%np) = pts%v(:, 1:pts%np) + dt * pts%a(:, 1:pts%np)
       else
-        ! Newmark β = 0: x uses v* (the displacement step 4 strained with) and a_p^n.
-        call g2p_add_scaled(basis, dt, nodes%vel, pts%x)
-        pts%x(:, 1:pts%np) = pts%x(:, 1:pts%np) + (g - 0.5_wp) * dt * dt * pts%a(:, 1:pts%np)
-        pts%v(:, 1:pts%np) = pts%v(:, 1:pts%np) + (1.0_wp - g) * dt * pts%a(:, 1:pts%np)
-        call g2p_value(basis, nodes%acc, pts%a)
-        pts%v(:, 1:pts%np) = pts%v(:, 1:pts%np) + g * dt * pts%a(:, 1:pts%np)
+        ! Newmark β = 0: x uses v* (the displacement step 4 strained with) and a_p^n; one
+        ! pass over the particles.
+        call g2p_pc_newmark(basis, dt, g, nodes%vel, nodes%acc, pts%x, pts%v, pts%a)
       end if
+      call tm%lap(PHASE_G2P)
     end associate
   end subroutine pc_step
 end module empm_integrator_pc

@@ -10,7 +10,7 @@
 module empm_material_linear_elastic
   use empm_kinds, only: wp
   use empm_material, only: empm_material_t
-  use empm_tensor, only: identity3, voigt_ddot
+  use empm_tensor, only: voigt_ddot, advance_f
   implicit none
   private
   public :: empm_linear_elastic_t, empm_elastic_check, empm_lame
@@ -90,7 +90,7 @@ contains
     real(wp), intent(inout) :: stress(:,:)           !! Cauchy stress, Voigt (6,n) [Pa]
     real(wp), intent(inout) :: rho(:)                !! density (n) [kg/m³]
     integer, intent(out) :: info                     !! 0 ok; k > 0 particle k failed; −1 shapes
-    real(wp) :: de(6), tr, eye(3,3)
+    real(wp) :: de(6), tr
     integer :: p, n
     info = 0
     n = size(rho)
@@ -99,7 +99,6 @@ contains
       info = -1
       return
     end if
-    eye = identity3()
     do p = 1, n
       de(1) = dt * L(1,1,p)
       de(2) = dt * L(2,2,p)
@@ -117,7 +116,7 @@ contains
       stress(1:3,p) = stress(1:3,p) + self%lambda * tr + 2.0_wp * self%mu * de(1:3)
       stress(4:6,p) = stress(4:6,p) + 2.0_wp * self%mu * de(4:6)
       rho(p) = rho(p) / (1.0_wp + tr)
-      F(:,:,p) = matmul(eye + dt * L(:,:,p), F(:,:,p))
+      F(:,:,p) = advance_f(dt, L(:,:,p), F(:,:,p))
     end do
   end subroutine le_update
 

@@ -14,7 +14,7 @@ module empm_material_neohookean
   use empm_kinds, only: wp
   use empm_material, only: empm_material_t
   use empm_material_linear_elastic, only: empm_elastic_check, empm_lame, MAT_OK
-  use empm_tensor, only: identity3, det3, mat_to_voigt
+  use empm_tensor, only: identity3, det3, mat_to_voigt, advance_f
   implicit none
   private
   public :: empm_neohookean_t, empm_neohookean_cauchy, empm_neohookean_energy
@@ -99,7 +99,7 @@ contains
     eye = identity3()
     do p = 1, n
       J0 = det3(F(:,:,p))
-      Fn = matmul(eye + dt * L(:,:,p), F(:,:,p))
+      Fn = advance_f(dt, L(:,:,p), F(:,:,p))
       J1 = det3(Fn)
       ! Inverted or degenerate element: ln J is undefined, stop before producing NaN.
       if (J0 <= 0.0_wp .or. J1 <= 0.0_wp) then

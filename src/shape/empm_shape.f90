@@ -44,6 +44,7 @@ module empm_shape
     procedure(eval_point_iface), deferred :: eval_point
     procedure(eval_batch_iface), deferred :: eval_batch
     procedure(name_iface), deferred :: name
+    procedure :: eval_batch_iters => shape_eval_batch_iters
   end type empm_shape_t
 
   abstract interface
@@ -89,6 +90,21 @@ module empm_shape
   end interface
 
 contains
+
+  !> `eval_batch` that also returns the iterations spent (summed over the particles); the
+  !> default is for direct (non-iterative) families: no iterations. Iterative families (LME)
+  !> override it.
+  subroutine shape_eval_batch_iters(self, grid, pts, basis, ibad, info, iters)
+    class(empm_shape_t), intent(in) :: self      !! shape family
+    type(empm_grid_t), intent(in) :: grid        !! background grid
+    type(empm_particles_t), intent(inout) :: pts !! particles
+    type(empm_basis_t), intent(inout) :: basis   !! filled for particles 1..pts%np
+    integer, intent(out) :: ibad                 !! first failing particle, 0 if none
+    integer, intent(out) :: info                 !! SHAPE_OK or the failing particle's code
+    integer, intent(out) :: iters                !! iterations summed over the particles
+    call self%eval_batch(grid, pts, basis, ibad, info)
+    iters = 0
+  end subroutine shape_eval_batch_iters
 
   !> Allocate basis storage for `np` particles with up to `maxn` nodes each.
   subroutine basis_alloc(self, ndim, maxn, np)

@@ -10,6 +10,7 @@ module empm_shape_linear
   use empm_kinds, only: wp
   use empm_grid, only: empm_grid_t
   use empm_particles, only: empm_particles_t
+  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES
   implicit none
@@ -76,18 +77,26 @@ contains
     type(empm_basis_t), intent(inout) :: basis     !! filled for particles 1..pts%np
     integer, intent(out) :: ibad                   !! first failing particle, 0 if none
     integer, intent(out) :: info                   !! SHAPE_OK or the failing particle's code
-    integer :: p
+    integer :: p, pinfo
     associate (unused_ => self); end associate
     call shape_batch_fits(pts%np, basis, ibad, info)
     if (info /= SHAPE_OK) return
+    ! Particles are independent: threads share them; the first failure (lowest index) is kept.
+    ibad = huge(1)
+    !$omp parallel do schedule(static) private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
       call shape_linear_kernel(grid, pts%x(:, p), basis%nn(p), basis%node(:, p), &
-                               basis%N(:, p), basis%dN(:, :, p), info)
-      if (info /= SHAPE_OK) then
-        ibad = p
-        return
+                               basis%N(:, p), basis%dN(:, :, p), pinfo)
+      if (pinfo /= SHAPE_OK) then
+        !$omp critical (empm_shape_failure)
+        if (p < ibad) then
+          ibad = p; info = pinfo
+        end if
+        !$omp end critical (empm_shape_failure)
       end if
     end do
+    !$omp end parallel do
+    if (ibad == huge(1)) ibad = 0
   end subroutine linear_eval_batch
 
   !> Linear shape functions at one point: the 2^ndim nodes of the cell holding `x`.

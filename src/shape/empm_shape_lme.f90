@@ -82,6 +82,7 @@ module empm_shape_lme
   use empm_kinds, only: wp
   use empm_grid, only: empm_grid_t
   use empm_particles, only: empm_particles_t
+  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_NOT_CONVERGED, SHAPE_OUTSIDE_HULL, &
                         SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES
@@ -284,7 +285,7 @@ contains
   ! ---- evaluation -------------------------------------------------------------------------------
 
   !> Batch loop without polymorphic calls: one [[lme_point_remedy]] per particle.
-  pure subroutine lme_batch(self, grid, pts, basis, ibad, info, iters)
+  subroutine lme_batch(self, grid, pts, basis, ibad, info, iters)
     type(empm_shape_lme_t), intent(in) :: self   !! shape family
     type(empm_grid_t), intent(in) :: grid        !! background grid
     type(empm_particles_t), intent(inout) :: pts !! particles (λ updated)
@@ -292,19 +293,27 @@ contains
     integer, intent(out) :: ibad                 !! first failing particle, 0 if none
     integer, intent(out) :: info                 !! SHAPE_OK or the failing particle's code
     integer, intent(out) :: iters                !! total Newton iterations
-    integer :: p, it
+    integer :: p, it, pinfo
     iters = 0
     call shape_batch_fits(pts%np, basis, ibad, info)
     if (info /= SHAPE_OK) return
+    ! Particles are independent: threads share them; the first failure (lowest index) is kept.
+    ibad = huge(1)
+    !$omp parallel do schedule(static) private(pinfo, it) reduction(+: iters) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
       call lme_point_remedy(self, grid, pts%x(:, p), pts%lam(:, p), basis%nn(p), &
-                            basis%node(:, p), basis%N(:, p), basis%dN(:, :, p), it, info)
+                            basis%node(:, p), basis%N(:, p), basis%dN(:, :, p), it, pinfo)
       iters = iters + it
-      if (info /= SHAPE_OK) then
-        ibad = p
-        return
+      if (pinfo /= SHAPE_OK) then
+        !$omp critical (empm_shape_failure)
+        if (p < ibad) then
+          ibad = p; info = pinfo
+        end if
+        !$omp end critical (empm_shape_failure)
       end if
     end do
+    !$omp end parallel do
+    if (ibad == huge(1)) ibad = 0
   end subroutine lme_batch
 
   !> One point, with the 'enlarge' remedy when enabled.

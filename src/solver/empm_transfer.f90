@@ -1,44 +1,193 @@
 !> Particle-grid transfer kernels shared by every integrator: P2G of mass, momentum-like
 !> quantities and forces; G2P interpolation of values and gradients; nodal constraints.
 !>
-!> All kernels are pure loops over contiguous per-particle basis blocks; none allocates.
+!> No kernel allocates. With OpenMP, G2P kernels split the particles among the threads
+!> (each particle is independent, so results do not depend on the thread count). P2G is made
+!> race-free with per-thread nodal buffers ([[empm_p2g_work_t]], allocated once): the
+!> particles are cut into `nt` contiguous chunks, chunk 1 accumulates straight into the
+!> target, chunk c > 1 into buffer c, and the buffers are added to the target node by node, in
+!> chunk order, over the node range each chunk touched. Sums are therefore fixed for a given
+!> thread count (reproducible run to run) and equal to the serial sums to round-off; with one
+!> thread, or without a workspace, they are the serial sums bit for bit.
 module empm_transfer
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   use empm_shape, only: empm_basis_t
   use empm_nodes, only: empm_nodes_t
+  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
   implicit none
   private
+  public :: empm_p2g_work_t
   public :: p2g_mass, p2g_weighted, p2g_internal_force, p2g_body_force
-  public :: g2p_value, g2p_add_scaled, velocity_gradient
+  public :: g2p_value, g2p_add_scaled, g2p_pc_newmark, velocity_gradient
   public :: nodal_divide_by_mass, constrain_velocity, constrain_force
+
+  !> Per-thread nodal accumulators of a race-free P2G; kept zero between calls.
+  type :: empm_p2g_work_t
+    integer :: nt = 1                       !! particle chunks (threads); 1 = serial
+    real(wp), allocatable :: buf(:,:,:)     !! accumulators of chunks 2..nt (ndim, nnode, nt-1)
+    integer, allocatable :: lo(:)           !! first node touched by each chunk (nt)
+    integer, allocatable :: hi(:)           !! last node touched by each chunk (nt)
+  contains
+    procedure :: init => p2g_work_init
+  end type empm_p2g_work_t
 
 contains
 
-  !> Lumped mass m_I = Σ_p N_Ip m_p (accumulated into `mass`).
-  pure subroutine p2g_mass(basis, m, mass)
-    type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
-    real(wp), intent(in) :: m(:)            !! particle masses
-    real(wp), intent(inout) :: mass(:)      !! nodal masses (accumulated)
+  !> Size the workspace for `nthreads` threads (serial when there are too few particles for
+  !> threads to pay off). Call at set-up, never in the time loop.
+  subroutine p2g_work_init(self, ndim, nnode, np, nthreads)
+    class(empm_p2g_work_t), intent(inout) :: self !! workspace
+    integer, intent(in) :: ndim                   !! spatial dimension
+    integer, intent(in) :: nnode                  !! number of grid nodes
+    integer, intent(in) :: np                     !! number of particles
+    integer, intent(in) :: nthreads               !! threads to use
+    self%nt = max(1, nthreads)
+    if (np < EMPM_OMP_MIN_PARTICLES) self%nt = 1
+    if (allocated(self%buf)) deallocate(self%buf, self%lo, self%hi)
+    allocate(self%buf(ndim, nnode, self%nt - 1), self%lo(self%nt), self%hi(self%nt))
+    self%buf = 0.0_wp
+    self%lo = 1; self%hi = 0
+  end subroutine p2g_work_init
+
+  !> Particles p0..p1 of chunk c (0-based) of n chunks over np particles.
+  pure subroutine chunk_bounds(np, n, c, p0, p1)
+    integer, intent(in) :: np, n, c
+    integer, intent(out) :: p0, p1
+    p0 = int(int(np, int64) * c / n) + 1
+    p1 = int(int(np, int64) * (c + 1) / n)
+  end subroutine chunk_bounds
+
+  !> Node range touched by particles p0..p1 (empty range lo > hi when there are none).
+  pure subroutine node_range(basis, p0, p1, lo, hi)
+    type(empm_basis_t), intent(in) :: basis
+    integer, intent(in) :: p0, p1
+    integer, intent(out) :: lo, hi
     integer :: p, k
-    do p = 1, basis%np
+    lo = huge(1); hi = 0
+    do p = p0, p1
+      do k = 1, basis%nn(p)
+        lo = min(lo, basis%node(k, p)); hi = max(hi, basis%node(k, p))
+      end do
+    end do
+    if (hi == 0) lo = 1
+  end subroutine node_range
+
+  !> Add the chunk buffers to `q` (in chunk order) and zero them again.
+  subroutine reduce_vec(ws, q)
+    type(empm_p2g_work_t), intent(inout) :: ws
+    real(wp), intent(inout) :: q(:,:)
+    integer :: I, c, ilo, ihi
+    ilo = minval(ws%lo(2:ws%nt)); ihi = maxval(ws%hi(2:ws%nt))
+    !$omp do schedule(static)
+    do I = ilo, ihi
+      do c = 2, ws%nt
+        if (I < ws%lo(c) .or. I > ws%hi(c)) cycle
+        q(:, I) = q(:, I) + ws%buf(:, I, c - 1)
+        ws%buf(:, I, c - 1) = 0.0_wp
+      end do
+    end do
+    !$omp end do
+  end subroutine reduce_vec
+
+  !> As [[reduce_vec]] for a scalar nodal field (first buffer component).
+  subroutine reduce_scalar(ws, q)
+    type(empm_p2g_work_t), intent(inout) :: ws
+    real(wp), intent(inout) :: q(:)
+    integer :: I, c, ilo, ihi
+    ilo = minval(ws%lo(2:ws%nt)); ihi = maxval(ws%hi(2:ws%nt))
+    !$omp do schedule(static)
+    do I = ilo, ihi
+      do c = 2, ws%nt
+        if (I < ws%lo(c) .or. I > ws%hi(c)) cycle
+        q(I) = q(I) + ws%buf(1, I, c - 1)
+        ws%buf(1, I, c - 1) = 0.0_wp
+      end do
+    end do
+    !$omp end do
+  end subroutine reduce_scalar
+
+  !> Lumped mass m_I = Σ_p N_Ip m_p (accumulated into `mass`).
+  subroutine p2g_mass(basis, m, mass, ws)
+    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                             !! particle masses
+    real(wp), intent(inout) :: mass(:)                       !! nodal masses (accumulated)
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
+    integer :: c, p0, p1
+    if (.not. present(ws)) then
+      call mass_range(basis, m, 1, basis%np, mass); return
+    else if (ws%nt <= 1) then
+      call mass_range(basis, m, 1, basis%np, mass); return
+    end if
+    !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
+    !$omp do schedule(static, 1)
+    do c = 1, ws%nt
+      call chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
+      if (c == 1) then
+        call mass_range(basis, m, p0, p1, mass)
+      else
+        call node_range(basis, p0, p1, ws%lo(c), ws%hi(c))
+        call mass_range(basis, m, p0, p1, ws%buf(1, :, c - 1))
+      end if
+    end do
+    !$omp end do
+    call reduce_scalar(ws, mass)
+    !$omp end parallel
+  end subroutine p2g_mass
+
+  pure subroutine mass_range(basis, m, p0, p1, mass)
+    type(empm_basis_t), intent(in) :: basis
+    real(wp), intent(in) :: m(:)
+    integer, intent(in) :: p0, p1
+    real(wp), intent(inout) :: mass(:)
+    integer :: p, k
+    do p = p0, p1
       do k = 1, basis%nn(p)
         mass(basis%node(k, p)) = mass(basis%node(k, p)) + basis%N(k, p) * m(p)
       end do
     end do
-  end subroutine p2g_mass
+  end subroutine mass_range
 
   !> Mass-weighted transfer q_I += Σ_p N_Ip m_p (u_p + c·w_p), e.g. momentum (c = 0) or the
   !> predictor's v_p + (1−γ)Δt a_p.
-  pure subroutine p2g_weighted(basis, m, u, c, w, q)
-    type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
-    real(wp), intent(in) :: m(:)            !! particle masses
-    real(wp), intent(in) :: u(:,:)          !! particle vectors (ndim, np)
-    real(wp), intent(in) :: c               !! scale of the second vector (0 to ignore it)
-    real(wp), intent(in) :: w(:,:)          !! second particle vectors (ndim, np)
-    real(wp), intent(inout) :: q(:,:)       !! nodal vectors (ndim, nnode), accumulated
+  subroutine p2g_weighted(basis, m, u, c, w, q, ws)
+    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                             !! particle masses
+    real(wp), intent(in) :: u(:,:)                           !! particle vectors (ndim, np)
+    real(wp), intent(in) :: c                                !! scale of the second vector (0 to ignore it)
+    real(wp), intent(in) :: w(:,:)                           !! second particle vectors (ndim, np)
+    real(wp), intent(inout) :: q(:,:)                        !! nodal vectors (ndim, nnode), accumulated
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
+    integer :: ic, p0, p1
+    if (.not. present(ws)) then
+      call weighted_range(basis, m, u, c, w, 1, basis%np, q); return
+    else if (ws%nt <= 1) then
+      call weighted_range(basis, m, u, c, w, 1, basis%np, q); return
+    end if
+    !$omp parallel num_threads(ws%nt) default(shared) private(ic, p0, p1)
+    !$omp do schedule(static, 1)
+    do ic = 1, ws%nt
+      call chunk_bounds(basis%np, ws%nt, ic - 1, p0, p1)
+      if (ic == 1) then
+        call weighted_range(basis, m, u, c, w, p0, p1, q)
+      else
+        call node_range(basis, p0, p1, ws%lo(ic), ws%hi(ic))
+        call weighted_range(basis, m, u, c, w, p0, p1, ws%buf(:, :, ic - 1))
+      end if
+    end do
+    !$omp end do
+    call reduce_vec(ws, q)
+    !$omp end parallel
+  end subroutine p2g_weighted
+
+  pure subroutine weighted_range(basis, m, u, c, w, p0, p1, q)
+    type(empm_basis_t), intent(in) :: basis
+    real(wp), intent(in) :: m(:), u(:,:), c, w(:,:)
+    integer, intent(in) :: p0, p1
+    real(wp), intent(inout) :: q(:,:)
     real(wp) :: mu(size(u, 1))
     integer :: p, k, I
-    do p = 1, basis%np
+    do p = p0, p1
       if (c == 0.0_wp) then
         mu = m(p) * u(:, p)
       else
@@ -49,18 +198,46 @@ contains
         q(:, I) = q(:, I) + basis%N(k, p) * mu
       end do
     end do
-  end subroutine p2g_weighted
+  end subroutine weighted_range
 
   !> Internal force f_I −= Σ_p V_p σ_p ∇N_Ip (paper eq. 16), σ in Voigt order.
-  pure subroutine p2g_internal_force(basis, vol, stress, f)
-    type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
-    real(wp), intent(in) :: vol(:)          !! particle volumes
-    real(wp), intent(in) :: stress(:,:)     !! Cauchy stress (6, np)
-    real(wp), intent(inout) :: f(:,:)       !! nodal forces (ndim, nnode), accumulated
-    real(wp) :: s(3, 3), g(3)
-    integer :: p, k, I, d
+  subroutine p2g_internal_force(basis, vol, stress, f, ws)
+    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
+    real(wp), intent(in) :: vol(:)                           !! particle volumes
+    real(wp), intent(in) :: stress(:,:)                      !! Cauchy stress (6, np)
+    real(wp), intent(inout) :: f(:,:)                        !! nodal forces (ndim, nnode), accumulated
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
+    integer :: c, p0, p1
+    if (.not. present(ws)) then
+      call internal_range(basis, vol, stress, 1, basis%np, f); return
+    else if (ws%nt <= 1) then
+      call internal_range(basis, vol, stress, 1, basis%np, f); return
+    end if
+    !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
+    !$omp do schedule(static, 1)
+    do c = 1, ws%nt
+      call chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
+      if (c == 1) then
+        call internal_range(basis, vol, stress, p0, p1, f)
+      else
+        call node_range(basis, p0, p1, ws%lo(c), ws%hi(c))
+        call internal_range(basis, vol, stress, p0, p1, ws%buf(:, :, c - 1))
+      end if
+    end do
+    !$omp end do
+    call reduce_vec(ws, f)
+    !$omp end parallel
+  end subroutine p2g_internal_force
+
+  pure subroutine internal_range(basis, vol, stress, p0, p1, f)
+    type(empm_basis_t), intent(in) :: basis
+    real(wp), intent(in) :: vol(:), stress(:,:)
+    integer, intent(in) :: p0, p1
+    real(wp), intent(inout) :: f(:,:)
+    real(wp) :: s(3, 3), t
+    integer :: p, k, I, d, a, b
     d = basis%ndim
-    do p = 1, basis%np
+    do p = p0, p1
       s(1, 1) = stress(1, p); s(2, 2) = stress(2, p); s(3, 3) = stress(3, p)
       s(2, 3) = stress(4, p); s(3, 2) = stress(4, p)
       s(1, 3) = stress(5, p); s(3, 1) = stress(5, p)
@@ -68,23 +245,60 @@ contains
       s = vol(p) * s
       do k = 1, basis%nn(p)
         I = basis%node(k, p)
-        g(1:d) = basis%dN(:, k, p)
-        f(:, I) = f(:, I) - matmul(s(1:d, 1:d), g(1:d))
+        ! (σV ∇N)_a summed over b in order, as matmul did, without its run-time-sized temporary.
+        do a = 1, d
+          t = 0.0_wp
+          do b = 1, d
+            t = t + s(a, b) * basis%dN(b, k, p)
+          end do
+          f(a, I) = f(a, I) - t
+        end do
       end do
     end do
-  end subroutine p2g_internal_force
+  end subroutine internal_range
 
   !> External body force f_I += Σ_p N_Ip m_p (g + b_p) (paper eq. 17 without tractions).
-  pure subroutine p2g_body_force(basis, m, g, b, use_b, f)
-    type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
-    real(wp), intent(in) :: m(:)            !! particle masses
-    real(wp), intent(in) :: g(:)            !! uniform acceleration (gravity) (ndim)
-    real(wp), intent(in) :: b(:,:)          !! per-particle body force per unit mass (ndim, np)
-    logical, intent(in) :: use_b            !! whether `b` holds data
-    real(wp), intent(inout) :: f(:,:)       !! nodal forces (ndim, nnode), accumulated
+  subroutine p2g_body_force(basis, m, g, b, use_b, f, ws)
+    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                             !! particle masses
+    real(wp), intent(in) :: g(:)                             !! uniform acceleration (gravity) (ndim)
+    real(wp), intent(in) :: b(:,:)                           !! per-particle body force per unit mass (ndim, np)
+    logical, intent(in) :: use_b                             !! whether `b` holds data
+    real(wp), intent(inout) :: f(:,:)                        !! nodal forces (ndim, nnode), accumulated
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
+    integer :: c, p0, p1
+    ! Nothing to add: skip the pass (adding zeros leaves f unchanged bit for bit).
+    if (.not. use_b .and. all(g == 0.0_wp)) return
+    if (.not. present(ws)) then
+      call body_range(basis, m, g, b, use_b, 1, basis%np, f); return
+    else if (ws%nt <= 1) then
+      call body_range(basis, m, g, b, use_b, 1, basis%np, f); return
+    end if
+    !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
+    !$omp do schedule(static, 1)
+    do c = 1, ws%nt
+      call chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
+      if (c == 1) then
+        call body_range(basis, m, g, b, use_b, p0, p1, f)
+      else
+        call node_range(basis, p0, p1, ws%lo(c), ws%hi(c))
+        call body_range(basis, m, g, b, use_b, p0, p1, ws%buf(:, :, c - 1))
+      end if
+    end do
+    !$omp end do
+    call reduce_vec(ws, f)
+    !$omp end parallel
+  end subroutine p2g_body_force
+
+  pure subroutine body_range(basis, m, g, b, use_b, p0, p1, f)
+    type(empm_basis_t), intent(in) :: basis
+    real(wp), intent(in) :: m(:), g(:), b(:,:)
+    logical, intent(in) :: use_b
+    integer, intent(in) :: p0, p1
+    real(wp), intent(inout) :: f(:,:)
     real(wp) :: fp(size(g))
     integer :: p, k, I
-    do p = 1, basis%np
+    do p = p0, p1
       fp = g
       if (use_b) fp = fp + b(:, p)
       fp = m(p) * fp
@@ -93,30 +307,33 @@ contains
         f(:, I) = f(:, I) + basis%N(k, p) * fp
       end do
     end do
-  end subroutine p2g_body_force
+  end subroutine body_range
 
   !> Interpolate a nodal vector to the particles: u_p = Σ_I N_Ip q_I.
-  pure subroutine g2p_value(basis, q, u)
+  subroutine g2p_value(basis, q, u)
     type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
     real(wp), intent(in) :: q(:,:)          !! nodal vectors (ndim, nnode)
     real(wp), intent(out) :: u(:,:)         !! particle vectors (ndim, np)
     integer :: p, k
+    !$omp parallel do schedule(static) private(k) if(basis%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, basis%np
       u(:, p) = 0.0_wp
       do k = 1, basis%nn(p)
         u(:, p) = u(:, p) + basis%N(k, p) * q(:, basis%node(k, p))
       end do
     end do
+    !$omp end parallel do
   end subroutine g2p_value
 
   !> Add a scaled interpolated nodal vector: u_p += c Σ_I N_Ip q_I.
-  pure subroutine g2p_add_scaled(basis, c, q, u)
+  subroutine g2p_add_scaled(basis, c, q, u)
     type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
     real(wp), intent(in) :: c               !! scale (e.g. Δt)
     real(wp), intent(in) :: q(:,:)          !! nodal vectors (ndim, nnode)
     real(wp), intent(inout) :: u(:,:)       !! particle vectors (ndim, np)
     real(wp) :: s(size(u, 1))
     integer :: p, k
+    !$omp parallel do schedule(static) private(k, s) if(basis%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, basis%np
       s = 0.0_wp
       do k = 1, basis%nn(p)
@@ -124,15 +341,48 @@ contains
       end do
       u(:, p) = u(:, p) + c * s
     end do
+    !$omp end parallel do
   end subroutine g2p_add_scaled
 
+  !> The Newmark-consistent particle update of the predictor-corrector in one pass over the
+  !> particles (the same arithmetic as the separate G2P calls, in the same order):
+  !> x += Δt Σ N v*_I + (γ − ½)Δt² a;  v += (1−γ)Δt a;  a = Σ N a_I;  v += γΔt a.
+  subroutine g2p_pc_newmark(basis, dt, g, vel, acc, x, v, a)
+    type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
+    real(wp), intent(in) :: dt              !! time step [s]
+    real(wp), intent(in) :: g               !! Newmark γ
+    real(wp), intent(in) :: vel(:,:)        !! predicted nodal velocities v*_I (ndim, nnode)
+    real(wp), intent(in) :: acc(:,:)        !! nodal accelerations a_I (ndim, nnode)
+    real(wp), intent(inout) :: x(:,:)       !! particle positions (ndim, np)
+    real(wp), intent(inout) :: v(:,:)       !! particle velocities (ndim, np)
+    real(wp), intent(inout) :: a(:,:)       !! particle accelerations (ndim, np): a^n in, a^{n+1} out
+    real(wp) :: sv(size(x, 1)), sa(size(x, 1))
+    integer :: p, k, I
+    !$omp parallel do schedule(static) private(k, I, sv, sa) if(basis%np >= EMPM_OMP_MIN_PARTICLES)
+    do p = 1, basis%np
+      sv = 0.0_wp; sa = 0.0_wp
+      do k = 1, basis%nn(p)
+        I = basis%node(k, p)
+        sv = sv + basis%N(k, p) * vel(:, I)
+        sa = sa + basis%N(k, p) * acc(:, I)
+      end do
+      x(:, p) = x(:, p) + dt * sv
+      x(:, p) = x(:, p) + (g - 0.5_wp) * dt * dt * a(:, p)
+      v(:, p) = v(:, p) + (1.0_wp - g) * dt * a(:, p)
+      a(:, p) = sa
+      v(:, p) = v(:, p) + g * dt * a(:, p)
+    end do
+    !$omp end parallel do
+  end subroutine g2p_pc_newmark
+
   !> Velocity gradient L_p = Σ_I v_I ⊗ ∇N_Ip, embedded in 3×3 (zeros in unused directions).
-  pure subroutine velocity_gradient(basis, v, L)
+  subroutine velocity_gradient(basis, v, L)
     type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
     real(wp), intent(in) :: v(:,:)          !! nodal velocities (ndim, nnode)
     real(wp), intent(out) :: L(:,:,:)       !! velocity gradients (3, 3, np)
     integer :: p, k, I, a, b, d
     d = basis%ndim
+    !$omp parallel do schedule(static) private(k, I, a, b) if(basis%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, basis%np
       L(:, :, p) = 0.0_wp
       do k = 1, basis%nn(p)
@@ -144,6 +394,7 @@ contains
         end do
       end do
     end do
+    !$omp end parallel do
   end subroutine velocity_gradient
 
   !> out_I = q_I / m_I on nodes with mass above the empty-node threshold, 0 elsewhere.

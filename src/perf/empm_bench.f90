@@ -1,0 +1,235 @@
+!> The performance benchmark behind `empm bench` (docs/performance.md): an elastic block
+!> vibrating freely, stepped with a chosen shape family and integrator, timed after a warm-up,
+!> with phase timers, Newton iterations and resident memory per particle.
+!>
+!> The block fills `cells`^dim cells of size 1/cells (unit box), with `ppc` particles per cell
+!> at Gauss positions (`ppc` a perfect square in 2D, cube in 3D). Families whose support needs
+!> nodes past the material (uGIMP, B-splines) get one padding cell per side, so the particle
+!> count never depends on the family. The initial velocity is a smooth standing-wave field of
+!> small amplitude (the block is linear elastic and nothing is fixed); Δt is half the CFL limit.
+!> The timed loop calls the integrator's `step` only: no guards, no last-good copy, no output.
+module empm_bench
+  use, intrinsic :: iso_fortran_env, only: int64
+  use empm_kinds, only: wp, pi
+  use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_USAGE, EMPM_ERR_RUNTIME
+  use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
+  use empm_particle_gen, only: empm_fill, GEOM_BOX, PLACE_GAUSS
+  use empm_shape_factory, only: empm_shape_create
+  use empm_material_factory, only: empm_material_create
+  use empm_integrator, only: empm_integrator_t
+  use empm_integrator_factory, only: empm_integrator_create
+  use empm_solver, only: empm_stable_dt
+  use empm_timer, only: PHASE_COUNT, PHASE_NAMES
+  use empm_parallel, only: empm_set_threads, empm_max_threads
+  use empm_strings, only: str
+  implicit none
+  private
+  public :: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json, &
+            empm_peak_rss_bytes
+
+  real(wp), parameter :: BENCH_E = 1.0e7_wp     !! Young's modulus [Pa]
+  real(wp), parameter :: BENCH_NU = 0.3_wp      !! Poisson's ratio
+  real(wp), parameter :: BENCH_RHO = 1000.0_wp  !! density [kg/m³]
+  real(wp), parameter :: BENCH_V0 = 0.1_wp      !! velocity amplitude [m/s] (~1e-3 of c)
+
+  !> What to run.
+  type :: empm_bench_config_t
+    integer :: dim = 2                              !! spatial dimension, 2 or 3
+    character(len=16) :: shape = 'linear'           !! linear, ugimp, bspline2, bspline3, lme
+    real(wp) :: gamma = 3.0_wp                      !! LME γ
+    integer :: cells = 64                           !! cells per direction of the block
+    integer :: ppc = 4                              !! particles per cell (a perfect power)
+    integer :: steps = 50                           !! timed steps
+    integer :: warmup = 3                           !! untimed steps first
+    integer :: threads = 1                          !! OpenMP threads
+    character(len=16) :: integrator = 'pc_newmark'  !! scheme, see empm_integrator_names
+  end type empm_bench_config_t
+
+  !> What was measured (the JSON of `empm bench`, plus a checksum for tests).
+  type :: empm_bench_result_t
+    integer :: dim = 0                                  !! spatial dimension
+    character(len=:), allocatable :: shape              !! family identifier, e.g. lme_g3
+    character(len=:), allocatable :: integrator         !! scheme identifier
+    integer :: particles = 0                            !! particles
+    integer :: nodes = 0                                !! grid nodes
+    integer :: steps = 0                                !! timed steps
+    integer :: threads = 1                              !! threads actually available
+    real(wp) :: seconds = 0.0_wp                        !! wall time of the timed steps [s]
+    real(wp) :: particle_steps_per_second = 0.0_wp      !! particles × steps / seconds
+    real(wp) :: newton_iterations_mean = 0.0_wp         !! per particle-step (LME; else 0)
+    real(wp) :: bytes_per_particle = 0.0_wp             !! (peak RSS − baseline) / particles
+    real(wp) :: phase_seconds(PHASE_COUNT) = 0.0_wp     !! shape, p2g, grid, g2p, stress [s]
+    real(wp) :: checksum = 0.0_wp                       !! Σ|x| + Σ|v|/v0 + Σ|σ|/E at the end
+  end type empm_bench_result_t
+
+contains
+
+  !> Build the block, warm up, time `cfg%steps` steps. `err%code` is EMPM_ERR_USAGE for a bad
+  !> configuration and EMPM_ERR_RUNTIME when a step fails.
+  subroutine empm_bench_run(cfg, res, err)
+    type(empm_bench_config_t), intent(in) :: cfg     !! configuration
+    type(empm_bench_result_t), intent(out) :: res    !! measurements
+    type(empm_error_t), intent(out), optional :: err !! error, if present
+    type(empm_model_t) :: model
+    class(empm_integrator_t), allocatable :: integ
+    type(empm_step_status_t) :: stat
+    real(wp) :: zero3(3), hi(3), origin(3), h(3), dt, s
+    integer :: nper, pad, nd, info, nadd, p, d, k, ncell(3)
+    integer(int64) :: rss0, rss1, c0, c1, rate
+
+    nd = cfg%dim
+    if (nd < 2 .or. nd > 3) then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: --dim must be 2 or 3', err); return
+    end if
+    nper = nint(real(cfg%ppc, wp)**(1.0_wp / nd))
+    if (nper < 1 .or. nper > 4 .or. nper**nd /= cfg%ppc) then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: --ppc '//str(cfg%ppc)//' is not n**'// &
+        str(nd)//' with n in 1..4 (particles per cell, e.g. 4 or 9 in 2D, 8 or 27 in 3D)', err)
+      return
+    end if
+    if (cfg%cells < 2 .or. cfg%steps < 1 .or. cfg%warmup < 0 .or. cfg%threads < 1) then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: need --cells >= 2, --steps >= 1, --threads >= 1', &
+                      err); return
+    end if
+    call empm_set_threads(cfg%threads)
+    rss0 = empm_peak_rss_bytes()
+
+    select case (trim(cfg%shape))
+    case ('ugimp', 'bspline2', 'bspline3'); pad = 1
+    case default; pad = 0
+    end select
+    h = 1.0_wp / cfg%cells
+    origin = -pad * h
+    ncell = cfg%cells + 2 * pad
+    call model%grid%init(nd, origin(1:nd), h(1:nd), ncell(1:nd), info)
+    if (info /= 0) then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: invalid grid', err); return
+    end if
+    call empm_shape_create(trim(cfg%shape), nd, model%shape, info, gamma=cfg%gamma)
+    if (info /= 0) then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: unknown shape '''//trim(cfg%shape)// &
+        ''' or invalid --gamma (linear, ugimp, bspline2, bspline3, lme)', err); return
+    end if
+    call empm_integrator_create(trim(cfg%integrator), integ, info)
+    if (info /= 0) then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: unknown integrator '''//trim(cfg%integrator)//'''', &
+                      err); return
+    end if
+    allocate(model%mats(1))
+    call empm_material_create('linear_elastic', BENCH_E, BENCH_NU, BENCH_RHO, &
+                              model%mats(1)%model, info)
+    ! Exact capacity: no geometric growth (it would double the footprint being measured).
+    call model%pts%alloc(nd, cfg%ppc * cfg%cells**nd)
+    zero3 = 0.0_wp; hi = 0.0_wp; hi(1:nd) = 1.0_wp
+    call empm_fill(model%pts, model%grid, GEOM_BOX, zero3, hi, zero3, 0.0_wp, nper, &
+                   PLACE_GAUSS, BENCH_RHO, 1, nadd, info)
+    if (info /= 0) then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: particle generation failed', err); return
+    end if
+    ! Standing wave: component d varies as sin(π(d+k)x_k)-like products, zero on the faces.
+    do p = 1, model%pts%np
+      do d = 1, nd
+        s = BENCH_V0
+        do k = 1, nd
+          s = s * sin(pi * model%pts%x(k, p) * merge(2.0_wp, 1.0_wp, k == d))
+        end do
+        model%pts%v(d, p) = s
+      end do
+    end do
+    call model%finalize_setup()
+    call integ%prepare(model)
+    dt = 0.5_wp * empm_stable_dt(model)
+
+    do k = 1, cfg%warmup
+      call advance()
+      if (stat%code /= STEP_OK) return
+    end do
+    call integ%timer%reset()
+    call system_clock(c0, rate)
+    do k = 1, cfg%steps
+      call advance()
+      if (stat%code /= STEP_OK) return
+    end do
+    call system_clock(c1)
+    rss1 = empm_peak_rss_bytes()
+
+    res%dim = nd
+    res%shape = model%shape%name()
+    res%integrator = integ%name()
+    res%particles = model%pts%np
+    res%nodes = model%grid%nnode
+    res%steps = cfg%steps
+    res%threads = empm_max_threads()
+    res%seconds = real(c1 - c0, wp) / real(rate, wp)
+    res%particle_steps_per_second = real(res%particles, wp) * cfg%steps / max(res%seconds, 1.0e-9_wp)
+    if (integ%timer%basis_evals > 0) res%newton_iterations_mean = &
+      real(integ%timer%newton_iters, wp) / real(integ%timer%basis_evals, wp)
+    if (rss0 > 0 .and. rss1 > 0) res%bytes_per_particle = real(rss1 - rss0, wp) / res%particles
+    res%phase_seconds = integ%timer%seconds
+    associate (np => model%pts%np)
+      res%checksum = sum(abs(model%pts%x(:, 1:np))) + sum(abs(model%pts%v(:, 1:np))) / BENCH_V0 &
+                     + sum(abs(model%pts%stress(:, 1:np))) / BENCH_E
+    end associate
+
+  contains
+
+    subroutine advance()
+      call integ%step(model, dt, stat)
+      if (stat%code /= STEP_OK) then
+        call empm_raise(EMPM_ERR_RUNTIME, 'bench: step '//str(model%step + 1)// &
+          ' failed at particle '//str(stat%particle)//' (status '//str(stat%detail)//')', err)
+        return
+      end if
+      model%t = model%t + dt
+      model%step = model%step + 1
+    end subroutine advance
+  end subroutine empm_bench_run
+
+  !> Peak resident set size of this process (VmHWM of /proc/self/status) [bytes]; −1 when
+  !> unavailable (not Linux).
+  function empm_peak_rss_bytes() result(bytes)
+    integer(int64) :: bytes !! peak RSS [bytes], or −1
+    character(len=256) :: line
+    integer :: u, ios
+    integer(int64) :: kib
+    bytes = -1
+    open(newunit=u, file='/proc/self/status', action='read', status='old', iostat=ios)
+    if (ios /= 0) return
+    do
+      read(u, '(a)', iostat=ios) line
+      if (ios /= 0) exit
+      if (line(1:6) == 'VmHWM:') then
+        read(line(7:), *, iostat=ios) kib
+        if (ios == 0) bytes = 1024_int64 * kib
+        exit
+      end if
+    end do
+    close(u)
+  end function empm_peak_rss_bytes
+
+  !> One-line JSON object with the keys of docs/performance.md.
+  function empm_bench_json(res) result(s)
+    type(empm_bench_result_t), intent(in) :: res !! measurements
+    character(len=:), allocatable :: s           !! {"dim":2,"shape":"lme_g3",...}
+    integer :: k
+    s = '{"dim":'//str(res%dim)//',"shape":"'//res%shape//'","integrator":"'// &
+      res%integrator//'","particles":'//str(res%particles)//',"nodes":'//str(res%nodes)// &
+      ',"steps":'//str(res%steps)//',"threads":'//str(res%threads)//',"seconds":'// &
+      num(res%seconds)//',"particle_steps_per_second":'//num(res%particle_steps_per_second)// &
+      ',"newton_iterations_mean":'//num(res%newton_iterations_mean)//',"bytes_per_particle":'// &
+      num(res%bytes_per_particle)//',"phase_seconds":{'
+    do k = 1, PHASE_COUNT
+      if (k > 1) s = s//','
+      s = s//'"'//trim(PHASE_NAMES(k))//'":'//num(res%phase_seconds(k))
+    end do
+    s = s//'}}'
+  end function empm_bench_json
+
+  pure function num(x) result(s)
+    real(wp), intent(in) :: x
+    character(len=:), allocatable :: s
+    character(len=32) :: buf
+    write(buf, '(es15.8e2)') x
+    s = trim(adjustl(buf))
+  end function num
+end module empm_bench
