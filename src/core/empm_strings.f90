@@ -3,7 +3,7 @@ module empm_strings
   use empm_kinds, only: wp
   implicit none
   private
-  public :: str, lower
+  public :: str, lower, join
 
   !> Format a value as a trimmed string.
   interface str
@@ -55,4 +55,17 @@ contains
       if (c >= iachar('A') .and. c <= iachar('Z')) t(i:i) = achar(c + 32)
     end do
   end function lower
+
+  !> Reals formatted with [[str]] and joined by `sep`, e.g. join([1.0, 2.0], ', ').
+  pure function join(x, sep) result(s)
+    real(wp), intent(in) :: x(:)           !! values
+    character(len=*), intent(in) :: sep    !! separator
+    character(len=:), allocatable :: s     !! joined text
+    integer :: i
+    s = ''
+    do i = 1, size(x)
+      s = s//str(x(i))
+      if (i < size(x)) s = s//sep
+    end do
+  end function join
 end module empm_strings

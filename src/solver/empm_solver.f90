@@ -4,7 +4,7 @@ module empm_solver
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_RUNTIME, EMPM_ERR_USAGE
-  use empm_strings, only: str
+  use empm_strings, only: str, join
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK, STEP_SHAPE_FAILED
   use empm_integrator, only: empm_integrator_t
   use empm_particles, only: empm_particles_t
@@ -241,12 +241,6 @@ contains
   pure function vec(x) result(s)
     real(wp), intent(in) :: x(:)
     character(len=:), allocatable :: s
-    integer :: i
-    s = '('
-    do i = 1, size(x)
-      s = s//str(x(i))
-      if (i < size(x)) s = s//', '
-    end do
-    s = s//')'
+    s = '('//join(x, ', ')//')'
   end function vec
 end module empm_solver

@@ -5,7 +5,7 @@
 module empm_verify_suite
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit, int64
   use empm_kinds, only: wp
-  use empm_strings, only: str
+  use empm_strings, only: str, join
   use empm_error, only: empm_error_t, EMPM_OK
   use empm_json, only: empm_json_t
   use empm_version_info, only: empm_version
@@ -355,23 +355,13 @@ contains
         call jc%end_object()
         write(output_unit, '(a)') trim(merge('pass ', 'FAIL ', ok))// &
           trim(merge(' (known failure)', '                ', expected))//' '//runs(a)%group//': errors '// &
-          join(es)//' observed order '//str(order)//' (>= '// &
+          join(es, ' ')//' observed order '//str(order)//' (>= '// &
           str(specs(runs(a)%spec)%min_order)//')'
         a = b + 1
       end do
     end subroutine convergence_groups
   end subroutine empm_verify_run
 
-  pure function join(x) result(s)
-    real(wp), intent(in) :: x(:)
-    character(len=:), allocatable :: s
-    integer :: i
-    s = ''
-    do i = 1, size(x)
-      s = s//str(x(i))
-      if (i < size(x)) s = s//' '
-    end do
-  end function join
 
   !> Run id with '/' made file-name safe.
   pure function flat(id) result(s)
