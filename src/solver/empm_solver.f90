@@ -211,16 +211,22 @@ contains
     associate (pts => model%pts)
       do p = 1, pts%np
         if (.not. all(ieee_is_finite(pts%x(:, p)))) then
-          msg = 'position'
+          msg = 'non-finite position'
         else if (.not. all(ieee_is_finite(pts%v(:, p)))) then
-          msg = 'velocity'
+          msg = 'non-finite velocity'
+        else if (.not. all(ieee_is_finite(pts%a(:, p)))) then
+          msg = 'non-finite acceleration'
         else if (.not. all(ieee_is_finite(pts%stress(:, p)))) then
-          msg = 'stress'
+          msg = 'non-finite stress'
+        else if (.not. all(ieee_is_finite(pts%strain(:, p)))) then
+          msg = 'non-finite strain'
         else if (.not. (ieee_is_finite(pts%rho(p)) .and. pts%rho(p) > 0.0_wp)) then
-          msg = 'density'
+          msg = 'non-finite or non-positive density'
+        else if (.not. (ieee_is_finite(pts%vol(p)) .and. pts%vol(p) > 0.0_wp)) then
+          msg = 'non-finite or non-positive volume'
         end if
         if (len(msg) > 0) then
-          msg = 'step '//str(model%step)//': non-finite '//msg//' at particle '//str(p)
+          msg = 'step '//str(model%step)//': '//msg//' at particle '//str(p)
           return
         end if
         if (.not. model%grid%inside(pts%x(:, p))) then
@@ -233,6 +239,10 @@ contains
     do I = 1, model%nodes%nnode
       if (.not. all(ieee_is_finite(model%nodes%vel(:, I)))) then
         msg = 'step '//str(model%step)//': non-finite nodal velocity at node '//str(I)
+        return
+      end if
+      if (.not. all(ieee_is_finite(model%nodes%acc(:, I)))) then
+        msg = 'step '//str(model%step)//': non-finite nodal acceleration at node '//str(I)
         return
       end if
     end do
