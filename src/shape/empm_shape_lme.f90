@@ -107,6 +107,8 @@ module empm_shape_lme
   integer, parameter :: LME_MAXIT_DEFAULT = 100     !! default Newton iteration cap
   !> Armijo sufficient-decrease constant and smallest step fraction.
   real(wp), parameter :: ARMIJO_C = 1.0e-4_wp, ARMIJO_TMIN = 1.0e-12_wp
+  !> Range of a sum of squares in which sqrt(sum) is accurate (no under- or overflow).
+  real(wp), parameter :: SUMSQ_LO = 1.0e-280_wp, SUMSQ_HI = 1.0e280_wp
   !> Most candidates for the direct hull test on failure (C(40, 4) = 91390 simplices in 3D).
   integer, parameter :: HULL_TEST_MAXN = 40
   !> Largest Frobenius condition of the candidates' covariance before they count as flat.
@@ -356,7 +358,7 @@ contains
     integer, intent(out) :: iters              !! Newton iterations
     integer, intent(out) :: info               !! SHAPE_OK or a SHAPE_* failure code
     real(wp) :: hs, cut, rmax, s, rd, xi(3), q, ga
-    integer :: nd, d, lo(3), hi(3), i, j, k, id, cap
+    integer :: nd, d, lo(3), hi(3), i, j, k, id, id0, cap
     logical :: varying
     nn = 0
     iters = 0
@@ -383,19 +385,19 @@ contains
       lo(d) = max(0, ceiling(s - rd))
       hi(d) = min(grid%ncell(d), floor(s + rd))
     end do
+    ! Node ids by integer arithmetic (the box is clipped to the grid); ξ along j and k once per
+    ! row. ξ and q are the same expressions as before, so the candidate set is unchanged.
     xi = 0.0_wp
+    ga = scale * self%gamma
     do k = lo(3), hi(3)
+      if (nd >= 3) xi(3) = (x(3) - (grid%origin(3) + k * grid%h(3))) / hs
       do j = lo(2), hi(2)
+        if (nd >= 2) xi(2) = (x(2) - (grid%origin(2) + j * grid%h(2))) / hs
+        id0 = 1 + grid%nn(1) * (j + grid%nn(2) * k)
         do i = lo(1), hi(1)
-          id = grid%node_id([i, j, k])
+          id = id0 + i
           xi(1) = (x(1) - (grid%origin(1) + i * grid%h(1))) / hs
-          if (nd >= 2) xi(2) = (x(2) - (grid%origin(2) + j * grid%h(2))) / hs
-          if (nd >= 3) xi(3) = (x(3) - (grid%origin(3) + k * grid%h(3))) / hs
-          if (varying) then
-            ga = scale * self%gamma_node(id)
-          else
-            ga = scale * self%gamma
-          end if
+          if (varying) ga = scale * self%gamma_node(id)
           q = ga * (xi(1)**2 + xi(2)**2 + xi(3)**2)
           if (q > cut) cycle
           nn = nn + 1
@@ -477,7 +479,8 @@ contains
     integer, intent(in), optional :: node(:)     !! grid node of each candidate
     real(wp) :: cut, q, qmax, lh(3), lt(3), r(3), rt(3), jm(3, 3), jt(3, 3), jinv(3, 3)
     real(wp) :: del(3), y(3), bm(3, 3), mv(3), logz, logzt, rn, t, slope, dnorm, zlow, p, ga
-    real(wp) :: cmean(3), cov(3, 3), cinv(3, 3), v(3), s, ximax, scl, cen(3), cent(3)
+    real(wp) :: cmean(3), cov(3, 3), cinv(3, 3), v(3), s, ximax, x2, x2max, scl, cen(3), cent(3)
+    real(wp) :: xlo(3), xhi(3)
     integer :: a, i, nact
     logical :: varying, ok, qvalid
 
@@ -490,35 +493,44 @@ contains
     varying = present(gnode) .and. present(node)
     cut = -log(tol0)
     main: block
-      ! Mark the active candidates: N(a) = −γ_a|ξ_a|² ≤ 0; inactive ones get N(a) = 1.
-      nact = 0; qmax = 0.0_wp; ximax = 0.0_wp
+      ! Mark the active candidates (γ_a|ξ_a|² ≤ −ln tol0) with N(a) = 0, inactive ones with
+      ! N(a) = −1. From here until the final values, N(a) ≥ 0 marks an active candidate and holds
+      ! its weight exp(f_a − max f) at the last λ evaluated (`moments` recomputes γ_a|ξ_a|²,
+      ! cheaper than storing it), so the final values need no exponential.
+      nact = 0; qmax = 0.0_wp; x2max = 0.0_wp
       cmean = 0.0_wp
+      xlo = huge(1.0_wp); xhi = -huge(1.0_wp)
       do a = 1, nc
-        q = gam(a) * sum(dN(1:nd, a)**2)
+        x2 = sum(dN(1:nd, a)**2)
+        q = gam(a) * x2
         if (q <= cut) then
-          N(a) = -q
+          N(a) = 0.0_wp
           nact = nact + 1
           qmax = max(qmax, q)
-          ximax = max(ximax, norm2(dN(1:nd, a)))
+          x2max = max(x2max, x2)
           cmean(1:nd) = cmean(1:nd) + dN(1:nd, a)
+          do i = 1, nd
+            xlo(i) = min(xlo(i), dN(i, a))
+            xhi(i) = max(xhi(i), dN(i, a))
+          end do
         else
-          N(a) = 1.0_wp
+          N(a) = -1.0_wp
         end if
       end do
+      ximax = sqrt(x2max)
       ! Direct hull tests: d+1 nodes, x in their bounding box, not all in one hyperplane.
       if (nact < nd + 1) then
         info = SHAPE_OUTSIDE_HULL; exit main
       end if
       do i = 1, nd
-        if (.not. (any(dN(i, 1:nc) >= 0.0_wp .and. N(1:nc) <= 0.0_wp) .and. &
-                   any(dN(i, 1:nc) <= 0.0_wp .and. N(1:nc) <= 0.0_wp))) then
+        if (.not. (xhi(i) >= 0.0_wp .and. xlo(i) <= 0.0_wp)) then
           info = SHAPE_OUTSIDE_HULL; exit main
         end if
       end do
       cmean = cmean / nact
       cov = 0.0_wp
       do a = 1, nc
-        if (N(a) > 0.0_wp) cycle
+        if (N(a) < 0.0_wp) cycle
         y(1:nd) = dN(1:nd, a) - cmean(1:nd)
         do i = 1, nd
           cov(1:nd, i) = cov(1:nd, i) + y(1:nd) * y(i)
@@ -534,11 +546,11 @@ contains
       lh = 0.0_wp
       lh(1:nd) = lam(1:nd) * h
       if (.not. all(abs(lh(1:nd)) <= LME_LAM_MAX)) lh = 0.0_wp
-      call moments(nd, nc, N, dN, lh, logz, r, jm, cen)
+      call moments(nd, nc, gamma, N, dN, lh, logz, r, jm, cen, gnode, node)
       ! log Z(λ*) = H(p*) − Σ p*γ_a|ξ_a|² ≥ −qmax: a smaller log Z proves there is no minimiser.
       zlow = -qmax - 1.0e-9_wp * (1.0_wp + qmax)
       do
-        rn = norm2(r(1:nd))
+        rn = norm_small(nd, r)
         if (rn < LME_TOL_CONV) exit
         if (logz < zlow) then
           info = SHAPE_OUTSIDE_HULL; exit main
@@ -555,18 +567,20 @@ contains
         ! Δ = −J⁻¹r = −(J/‖J‖)⁻¹r/‖J‖, capped at LME_STEP_MAX (J may be tiny far from λ*,
         ! when one node carries nearly all the weight).
         del = matvec(nd, jinv, r)
-        dnorm = norm2(del(1:nd))
+        dnorm = norm_small(nd, del)
         if (dnorm > LME_STEP_MAX * scl) then
           del = -del * (LME_STEP_MAX / dnorm)
         else
           del = -del / scl
         end if
         t = 1.0_wp
+        ! The first trial is the full step, and its moments are kept: the guard costs extra
+        ! evaluations only when it actually backtracks.
         if (rn > LME_TOL_GUARD) then
           slope = dot_product(r(1:nd), del(1:nd))
           do
             lt = lh + t * del
-            call moments(nd, nc, N, dN, lt, logzt, rt, jt, cent)
+            call moments(nd, nc, gamma, N, dN, lt, logzt, rt, jt, cent, gnode, node)
             if (logzt <= logz + ARMIJO_C * t * slope) exit
             t = 0.5_wp * t
             if (t < ARMIJO_TMIN) then
@@ -575,7 +589,7 @@ contains
           end do
         else
           lt = lh + del
-          call moments(nd, nc, N, dN, lt, logzt, rt, jt, cent)
+          call moments(nd, nc, gamma, N, dN, lt, logzt, rt, jt, cent, gnode, node)
         end if
         lh = lt; logz = logzt; r = rt; jm = jt; cen = cent
         iters = iters + 1
@@ -594,19 +608,20 @@ contains
       end if
       jinv = jinv / scl
       del = -matvec(nd, jinv, r)
-      if (norm2(del(1:nd)) * (ximax + norm2(r(1:nd))) > 0.5_wp) del = 0.0_wp
+      if (norm_small(nd, del) * (ximax + norm_small(nd, r)) > 0.5_wp) del = 0.0_wp
 
       ! Values p̃ and their moments; for node-wise γ also B = Σ p γ ξ⊗ξ and m = Σ p γ ξ.
-      ! (N holds p from here on, no longer −γ_a|ξ_a|².)
+      ! N(a) holds exp(f_a − max f) at λ, i.e. p_a up to the factor Z that the division by
+      ! s = Σp̃ below removes; from here N holds p̃ (0 for inactive candidates).
       qvalid = .false.
       s = 0.0_wp; rt = 0.0_wp; jt = 0.0_wp; bm = 0.0_wp; mv = 0.0_wp
       do a = 1, nc
-        if (N(a) > 0.0_wp) then
+        if (N(a) < 0.0_wp) then
           N(a) = 0.0_wp
           cycle
         end if
-        p = exp(N(a) + dot_product(lh(1:nd), dN(1:nd, a)) - logz)
-        p = p * (1.0_wp + dot_product(dN(1:nd, a) - r(1:nd), del(1:nd)))
+        v(1:nd) = dN(1:nd, a) - r(1:nd)
+        p = N(a) * (1.0_wp + dot_product(v(1:nd), del(1:nd)))
         N(a) = p
         s = s + p
         v(1:nd) = dN(1:nd, a) - cen(1:nd)
@@ -635,13 +650,13 @@ contains
       end if
       jinv = jinv / scl
       ! Gradients (see the module documentation), with the normalised p̃.
+      v = 0.0_wp
       do a = 1, nc
         if (N(a) == 0.0_wp) then
           dN(1:nd, a) = 0.0_wp
           cycle
         end if
         N(a) = N(a) / s
-        v = 0.0_wp
         v(1:nd) = dN(1:nd, a) - r(1:nd)
         y = matvec(nd, jinv, v)
         if (varying) then
@@ -686,14 +701,14 @@ contains
   pure logical function separates(nd, nc, q, xi, lh)
     integer, intent(in) :: nd        !! spatial dimension
     integer, intent(in) :: nc        !! number of candidates
-    real(wp), intent(in) :: q(:)     !! −γ_a|ξ_a|² (active), 1 (inactive)
+    real(wp), intent(in) :: q(:)     !! ≥ 0 (active), < 0 (inactive)
     real(wp), intent(in) :: xi(:,:)  !! ξ_a (nd, nc)
     real(wp), intent(in) :: lh(3)    !! λ·h
     integer :: a
     separates = .false.
     if (all(lh(1:nd) == 0.0_wp)) return
     do a = 1, nc
-      if (q(a) > 0.0_wp) cycle
+      if (q(a) < 0.0_wp) cycle
       if (dot_product(lh(1:nd), xi(1:nd, a)) >= 0.0_wp) return
     end do
     separates = .true.
@@ -704,35 +719,35 @@ contains
   pure logical function in_simplex_hull(nd, nc, q, xi)
     integer, intent(in) :: nd        !! spatial dimension
     integer, intent(in) :: nc        !! number of candidates
-    real(wp), intent(in) :: q(:)     !! −γ_a|ξ_a|² (active), 1 (inactive)
+    real(wp), intent(in) :: q(:)     !! ≥ 0 (active), < 0 (inactive)
     real(wp), intent(in) :: xi(:,:)  !! ξ_a (nd, nc)
     integer :: i, j, k, l
     in_simplex_hull = .true.
     select case (nd)
     case (1)
-      in_simplex_hull = any(xi(1, 1:nc) >= 0.0_wp .and. q(1:nc) <= 0.0_wp) .and. &
-                        any(xi(1, 1:nc) <= 0.0_wp .and. q(1:nc) <= 0.0_wp)
+      in_simplex_hull = any(xi(1, 1:nc) >= 0.0_wp .and. q(1:nc) >= 0.0_wp) .and. &
+                        any(xi(1, 1:nc) <= 0.0_wp .and. q(1:nc) >= 0.0_wp)
       return
     case (2)
       do i = 1, nc
-        if (q(i) > 0.0_wp) cycle
+        if (q(i) < 0.0_wp) cycle
         do j = i + 1, nc
-          if (q(j) > 0.0_wp) cycle
+          if (q(j) < 0.0_wp) cycle
           do k = j + 1, nc
-            if (q(k) > 0.0_wp) cycle
+            if (q(k) < 0.0_wp) cycle
             if (in_simplex(nd, xi(:, i), xi(:, j), xi(:, k), xi(:, k))) return
           end do
         end do
       end do
     case default
       do i = 1, nc
-        if (q(i) > 0.0_wp) cycle
+        if (q(i) < 0.0_wp) cycle
         do j = i + 1, nc
-          if (q(j) > 0.0_wp) cycle
+          if (q(j) < 0.0_wp) cycle
           do k = j + 1, nc
-            if (q(k) > 0.0_wp) cycle
+            if (q(k) < 0.0_wp) cycle
             do l = k + 1, nc
-              if (q(l) > 0.0_wp) cycle
+              if (q(l) < 0.0_wp) cycle
               if (in_simplex(nd, xi(:, i), xi(:, j), xi(:, k), xi(:, l))) return
             end do
           end do
@@ -793,45 +808,82 @@ contains
     end do
   end function matvec_t
 
-  !> log Z, r and J at λ (units of h) for the active candidates (q(a) ≤ 0), with the exponent
-  !> shifted by its maximum. The moments are taken about c = ξ of the heaviest node, so that
-  !> J = Σ p (ξ − c)⊗(ξ − c) − (r − c)⊗(r − c) has no cancellation when that node carries
-  !> nearly all the weight (large γ, far from λ*).
-  pure subroutine moments(nd, nc, q, xi, lh, logz, r, jm, c)
-    integer, intent(in) :: nd           !! spatial dimension
-    integer, intent(in) :: nc           !! number of candidates
-    real(wp), intent(in) :: q(:)        !! −γ_a|ξ_a|² (active), 1 (inactive)
-    real(wp), intent(in) :: xi(:,:)     !! ξ_a (nd, nc)
-    real(wp), intent(in) :: lh(3)       !! λ·h
-    real(wp), intent(out) :: logz       !! log Z
-    real(wp), intent(out) :: r(3)       !! r = Σ p ξ
-    real(wp), intent(out) :: jm(3, 3)   !! J = Σ p ξ⊗ξ − r⊗r
-    real(wp), intent(out) :: c(3)       !! centre of the moments (ξ of the heaviest node)
+  !> log Z, r and J at λ (units of h) for the active candidates (w(a) ≥ 0), with the exponent
+  !> f_a = −γ_a|ξ_a|² + λ·ξ_a shifted by its maximum; on return w(a) = exp(f_a − max f) for
+  !> the active candidates (reused for the final values). The moments are taken about c = ξ of
+  !> the heaviest node, so that J = Σ p (ξ − c)⊗(ξ − c) − (r − c)⊗(r − c) has no cancellation
+  !> when that node carries nearly all the weight (large γ, far from λ*).
+  pure subroutine moments(nd, nc, gamma, w, xi, lh, logz, r, jm, c, gnode, node)
+    integer, intent(in) :: nd                  !! spatial dimension
+    integer, intent(in) :: nc                  !! number of candidates
+    real(wp), intent(in) :: gamma              !! γ (uniform), or the factor of gnode
+    real(wp), intent(inout) :: w(:)            !! in: ≥ 0 active, < 0 inactive; out: weights
+    real(wp), intent(in) :: xi(:,:)            !! ξ_a (nd, nc)
+    real(wp), intent(in) :: lh(3)              !! λ·h
+    real(wp), intent(out) :: logz              !! log Z
+    real(wp), intent(out) :: r(3)              !! r = Σ p ξ
+    real(wp), intent(out) :: jm(3, 3)          !! J = Σ p ξ⊗ξ − r⊗r
+    real(wp), intent(out) :: c(3)              !! centre of the moments (ξ of the heaviest node)
+    real(wp), intent(in), optional :: gnode(:) !! γ per grid node
+    integer, intent(in), optional :: node(:)   !! grid node of each candidate
     real(wp) :: fmax, f, e, s, sr(3), sj(3, 3), u(3)
     integer :: a, i, amax
+    logical :: varying
+    varying = present(gnode) .and. present(node)
     fmax = -huge(1.0_wp)
     amax = 0
-    do a = 1, nc
-      if (q(a) > 0.0_wp) cycle
-      f = q(a) + dot_product(lh(1:nd), xi(1:nd, a))
-      if (f > fmax) then
-        fmax = f
-        amax = a
-      end if
-    end do
-    c = 0.0_wp
-    if (amax > 0) c(1:nd) = xi(1:nd, amax)
     s = 0.0_wp; sr = 0.0_wp; sj = 0.0_wp; u = 0.0_wp
-    do a = 1, nc
-      if (q(a) > 0.0_wp) cycle
-      e = exp(q(a) + dot_product(lh(1:nd), xi(1:nd, a)) - fmax)
-      s = s + e
-      u(1:nd) = xi(1:nd, a) - c(1:nd)
-      sr(1:nd) = sr(1:nd) + e * u(1:nd)
-      do i = 1, nd
-        sj(1:nd, i) = sj(1:nd, i) + (e * u(i)) * u(1:nd)
+    c = 0.0_wp
+    if (nd == 2 .and. .not. varying) then
+      ! The hot case, with scalars: the same expressions as the general loop below (same
+      ! results), without its short assumed-shape loops.
+      do a = 1, nc
+        if (w(a) < 0.0_wp) cycle
+        f = -(gamma * (xi(1, a) * xi(1, a) + xi(2, a) * xi(2, a))) + &
+            (lh(1) * xi(1, a) + lh(2) * xi(2, a))
+        if (f > fmax) then
+          fmax = f
+          amax = a
+        end if
       end do
-    end do
+      if (amax > 0) c(1:2) = xi(1:2, amax)
+      do a = 1, nc
+        if (w(a) < 0.0_wp) cycle
+        e = exp(-(gamma * (xi(1, a) * xi(1, a) + xi(2, a) * xi(2, a))) + &
+                (lh(1) * xi(1, a) + lh(2) * xi(2, a)) - fmax)
+        w(a) = e
+        s = s + e
+        u(1) = xi(1, a) - c(1)
+        u(2) = xi(2, a) - c(2)
+        sr(1) = sr(1) + e * u(1)
+        sr(2) = sr(2) + e * u(2)
+        sj(1, 1) = sj(1, 1) + (e * u(1)) * u(1)
+        sj(2, 1) = sj(2, 1) + (e * u(1)) * u(2)
+        sj(2, 2) = sj(2, 2) + (e * u(2)) * u(2)
+      end do
+      sj(1, 2) = sj(2, 1)
+    else
+      do a = 1, nc
+        if (w(a) < 0.0_wp) cycle
+        f = fexp(a)
+        if (f > fmax) then
+          fmax = f
+          amax = a
+        end if
+      end do
+      if (amax > 0) c(1:nd) = xi(1:nd, amax)
+      do a = 1, nc
+        if (w(a) < 0.0_wp) cycle
+        e = exp(fexp(a) - fmax)
+        w(a) = e
+        s = s + e
+        u(1:nd) = xi(1:nd, a) - c(1:nd)
+        sr(1:nd) = sr(1:nd) + e * u(1:nd)
+        do i = 1, nd
+          sj(1:nd, i) = sj(1:nd, i) + (e * u(i)) * u(1:nd)
+        end do
+      end do
+    end if
     logz = fmax + log(s)
     sr = sr / s
     r = c + sr
@@ -839,6 +891,17 @@ contains
     do i = 1, nd
       jm(1:nd, i) = sj(1:nd, i) / s - sr(1:nd) * sr(i)
     end do
+
+  contains
+
+    !> Exponent f_a (γ_a|ξ_a|² recomputed: a few flops, cheaper than storing it).
+    pure real(wp) function fexp(a)
+      integer, intent(in) :: a !! candidate
+      real(wp) :: g
+      g = gamma
+      if (varying) g = gamma * gnode(node(a))
+      fexp = -(g * sum(xi(1:nd, a)**2)) + dot_product(lh(1:nd), xi(1:nd, a))
+    end function fexp
   end subroutine moments
 
   !> Inverse of a symmetric d×d matrix (d ≤ 3) scaled to unit Frobenius norm, by its adjugate:
@@ -854,11 +917,11 @@ contains
     logical, intent(out) :: ok          !! inverse computed
     real(wp) :: b(3, 3), adj(3, 3), det, nadj
     ainv = 0.0_wp
-    adj = 0.0_wp
     ok = .false.
-    na = norm2(a(1:nd, 1:nd))
+    na = frob(nd, a)
     if (.not. (na > 0.0_wp .and. na <= huge(na))) return
-    b = a / na
+    ! Only the leading block is formed: b and adj beyond it are never read.
+    b(1:nd, 1:nd) = a(1:nd, 1:nd) / na
     select case (nd)
     case (1)
       adj(1, 1) = 1.0_wp
@@ -877,10 +940,47 @@ contains
       adj(2, 1) = adj(1, 2); adj(3, 1) = adj(1, 3); adj(3, 2) = adj(2, 3)
       det = b(1, 1) * adj(1, 1) + b(1, 2) * adj(2, 1) + b(1, 3) * adj(3, 1)
     end select
-    nadj = norm2(adj(1:nd, 1:nd))
+    nadj = frob(nd, adj)
     ok = det > 0.0_wp .and. det * cond_max > nadj
     if (ok) ainv(1:nd, 1:nd) = adj(1:nd, 1:nd) / det
   end subroutine sym_inverse
+
+  !> ‖a‖_F of the leading nd×nd block: sqrt of the plain sum of squares, falling back to the
+  !> scaled (slower) norm2 when that sum may have under- or overflowed.
+  pure real(wp) function frob(nd, a)
+    integer, intent(in) :: nd        !! dimension, 1..3
+    real(wp), intent(in) :: a(3, 3)  !! matrix
+    real(wp) :: ss
+    integer :: i, j
+    ss = 0.0_wp
+    do j = 1, nd
+      do i = 1, nd
+        ss = ss + a(i, j)**2
+      end do
+    end do
+    if (ss > SUMSQ_LO .and. ss < SUMSQ_HI) then
+      frob = sqrt(ss)
+    else
+      frob = norm2(a(1:nd, 1:nd))
+    end if
+  end function frob
+
+  !> |v| of the leading nd entries, as [[frob]].
+  pure real(wp) function norm_small(nd, v)
+    integer, intent(in) :: nd        !! dimension, 1..3
+    real(wp), intent(in) :: v(3)     !! vector
+    real(wp) :: ss
+    integer :: i
+    ss = 0.0_wp
+    do i = 1, nd
+      ss = ss + v(i)**2
+    end do
+    if (ss > SUMSQ_LO .and. ss < SUMSQ_HI) then
+      norm_small = sqrt(ss)
+    else
+      norm_small = norm2(v(1:nd))
+    end if
+  end function norm_small
 
   ! ---- helpers ------------------------------------------------------------------------------
 
