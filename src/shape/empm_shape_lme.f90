@@ -221,7 +221,8 @@ contains
     call lme_point_remedy(self, grid, x, lam, nn, node, N, dN, iters, info)
   end subroutine lme_eval_point_iters
 
-  !> Values and gradients at particles 1..pts%np, warm-started from and updating `pts%lam`;
+  !> Values and gradients at particles 1..pts%np, warm-started by extrapolation from `pts%lam`
+  !> and `pts%lam_old` (the last two converged multipliers) and updating both;
   !> stops at the first failing particle.
   subroutine lme_eval_batch(self, grid, pts, basis, ibad, info)
     class(empm_shape_lme_t), intent(in) :: self  !! shape family
@@ -295,16 +296,35 @@ contains
     integer, intent(out) :: ibad                 !! first failing particle, 0 if none
     integer, intent(out) :: info                 !! SHAPE_OK or the failing particle's code
     integer, intent(out) :: iters                !! total Newton iterations
-    integer :: p, it, pinfo
+    integer :: p, it, pinfo, nd
+    real(wp) :: lam(3)
     iters = 0
     call shape_batch_fits(pts%np, basis, ibad, info)
     if (info /= SHAPE_OK) return
+    nd = grid%ndim
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
-    !$omp parallel do schedule(static) private(pinfo, it) reduction(+: iters) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
+    !$omp parallel do schedule(static) private(pinfo, it, lam) reduction(+: iters) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
-      call lme_point_remedy(self, grid, pts%x(:, p), pts%lam(:, p), basis%nn(p), &
+      ! Warm start extrapolated from the last two converged multipliers: in a smooth motion
+      ! λ* changes smoothly, so 2λ_n − λ_(n−1) is off by O(Δx²) and one Newton step usually
+      ! reaches the tolerance (the plain warm start λ_n needs two). lam_old = huge marks a
+      ! particle without a converged history yet (set at generation): plain warm start.
+      if (pts%lam_old(1, p) == huge(1.0_wp)) then
+        lam(1:nd) = pts%lam(:, p)
+      else
+        lam(1:nd) = 2.0_wp * pts%lam(:, p) - pts%lam_old(:, p)
+      end if
+      call lme_point_remedy(self, grid, pts%x(:, p), lam(1:nd), basis%nn(p), &
                             basis%node(:, p), basis%N(:, p), basis%dN(:, :, p), it, pinfo)
+      if (pinfo == SHAPE_OK) then
+        if (pts%lam_old(1, p) == huge(1.0_wp)) then
+          pts%lam_old(:, p) = lam(1:nd)
+        else
+          pts%lam_old(:, p) = pts%lam(:, p)
+        end if
+        pts%lam(:, p) = lam(1:nd)
+      end if
       iters = iters + it
       if (pinfo /= SHAPE_OK) then
         !$omp critical (empm_shape_failure)
