@@ -3,14 +3,16 @@
 !> Each step: Δε = Δt·sym(L), ε ← ε + Δε, σ ← σ + D:Δε with the isotropic D (Lamé λ, μ),
 !> ρ ← ρ/(1 + tr Δε) (eq. 19). 1D uniaxial strain and 2D plane strain need no special case:
 !> the velocity gradient is zero in the unused directions, so the lateral stresses come out
-!> as λ·tr Δε by themselves. F ← (I + Δt L) F is kept for output only; the stress does not use it.
+!> as λ·tr Δε by themselves. The small-strain model does not track the deformation gradient: F
+!> is left as it is (identity) — updating it cost a third of the stress phase's memory traffic and
+!> nothing reads it.
 !>
 !> The module also holds what every isotropic elastic model shares: the parameter check
 !> [[empm_elastic_check]], the Lamé conversion [[empm_lame]] and the `MAT_*` status codes.
 module empm_material_linear_elastic
   use empm_kinds, only: wp
   use empm_material, only: empm_material_t
-  use empm_tensor, only: voigt_ddot, advance_f
+  use empm_tensor, only: voigt_ddot
   implicit none
   private
   public :: empm_linear_elastic_t, empm_elastic_check, empm_lame
@@ -85,7 +87,7 @@ contains
     class(empm_linear_elastic_t), intent(in) :: self !! material
     real(wp), intent(in) :: dt                       !! time step [s]
     real(wp), intent(in) :: L(:,:,:)                 !! velocity gradient (3,3,n) [1/s]
-    real(wp), intent(inout) :: F(:,:,:)              !! deformation gradient (3,3,n)
+    real(wp), intent(inout) :: F(:,:,:)              !! deformation gradient (3,3,n), left unchanged
     real(wp), intent(inout) :: strain(:,:)           !! small strain, Voigt (6,n)
     real(wp), intent(inout) :: stress(:,:)           !! Cauchy stress, Voigt (6,n) [Pa]
     real(wp), intent(inout) :: rho(:)                !! density (n) [kg/m³]
@@ -116,7 +118,6 @@ contains
       stress(1:3,p) = stress(1:3,p) + self%lambda * tr + 2.0_wp * self%mu * de(1:3)
       stress(4:6,p) = stress(4:6,p) + 2.0_wp * self%mu * de(4:6)
       rho(p) = rho(p) / (1.0_wp + tr)
-      F(:,:,p) = advance_f(dt, L(:,:,p), F(:,:,p))
     end do
   end subroutine le_update
 

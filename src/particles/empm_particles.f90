@@ -22,7 +22,8 @@ module empm_particles
     real(wp), allocatable :: rho(:)         !! current density (np) [kg/m³]
     real(wp), allocatable :: stress(:,:)    !! Cauchy stress, Voigt (6, np) [Pa]
     real(wp), allocatable :: strain(:,:)    !! accumulated small strain, Voigt (6, np)
-    real(wp), allocatable :: F(:,:,:)       !! deformation gradient (3, 3, np)
+    real(wp), allocatable :: F(:,:,:)       !! deformation gradient (3, 3, np): finite-strain
+                                            !! models (small-strain ones leave it = I)
     real(wp), allocatable :: L(:,:,:)       !! velocity gradient of the last step (3, 3, np) [1/s]
     real(wp), allocatable :: lp(:,:)        !! half-length of the particle domain (ndim, np) [m]
     real(wp), allocatable :: lam(:,:)       !! shape-function state (LME Lagrange multiplier) (ndim, np)

@@ -379,20 +379,24 @@ contains
   subroutine velocity_gradient(basis, v, L)
     type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
     real(wp), intent(in) :: v(:,:)          !! nodal velocities (ndim, nnode)
-    real(wp), intent(out) :: L(:,:,:)       !! velocity gradients (3, 3, np)
+    real(wp), intent(inout) :: L(:,:,:)     !! velocity gradients (3, 3, np); only the ndim×ndim
+                                            !! block is written (the rest stays 0 from set-up)
+    real(wp) :: g(3, 3)
     integer :: p, k, I, a, b, d
     d = basis%ndim
-    !$omp parallel do schedule(static) private(k, I, a, b) if(basis%np >= EMPM_OMP_MIN_PARTICLES)
+    !$omp parallel do schedule(static) private(k, I, a, b, g) if(basis%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, basis%np
-      L(:, :, p) = 0.0_wp
+      ! Accumulate in registers, store once: fewer writes to the particle array.
+      g = 0.0_wp
       do k = 1, basis%nn(p)
         I = basis%node(k, p)
         do b = 1, d
           do a = 1, d
-            L(a, b, p) = L(a, b, p) + v(a, I) * basis%dN(b, k, p)
+            g(a, b) = g(a, b) + v(a, I) * basis%dN(b, k, p)
           end do
         end do
       end do
+      L(1:d, 1:d, p) = g(1:d, 1:d)
     end do
     !$omp end parallel do
   end subroutine velocity_gradient
