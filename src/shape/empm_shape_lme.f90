@@ -113,6 +113,8 @@ module empm_shape_lme
   integer, parameter :: HULL_TEST_MAXN = 40
   !> Largest Frobenius condition of the candidates' covariance before they count as flat.
   real(wp), parameter :: FLAT_COND_MAX = 1.0e10_wp
+  !> Most candidates whose exponents [[moments]] keeps between its two passes (2D fast path).
+  integer, parameter :: MOM_BUF = 128
 
   !> Local max-ent shape functions with uniform or node-wise γ.
   type, extends(empm_shape_t) :: empm_shape_lme_t
@@ -426,7 +428,13 @@ contains
             info = SHAPE_TOO_MANY_NODES; return
           end if
           node(nn) = id
-          dN(1:nd, nn) = xi(1:nd)
+          if (nd == 2) then
+            ! 2D: explicit copy (the generic slice of run-time length costs ~30 instructions).
+            dN(1, nn) = xi(1)
+            dN(2, nn) = xi(2)
+          else
+            dN(1:nd, nn) = xi(1:nd)
+          end if
         end do
       end do
     end do
@@ -502,7 +510,7 @@ contains
     real(wp) :: cmean(3), cov(3, 3), cinv(3, 3), v(3), s, ximax, x2, x2max, scl, cen(3), cent(3)
     real(wp) :: xlo(3), xhi(3)
     integer :: a, i, nact
-    logical :: varying, ok, qvalid
+    logical :: varying, ok, qvalid, fast2d
 
     iters = 0
     info = SHAPE_OK
@@ -511,6 +519,7 @@ contains
     qvalid = .true.
     nact = 0
     varying = present(gnode) .and. present(node)
+    fast2d = nd == 2 .and. .not. varying
     cut = -log(tol0)
     main: block
       ! Mark the active candidates (γ_a|ξ_a|² ≤ −ln tol0) with N(a) = 0, inactive ones with
@@ -520,23 +529,45 @@ contains
       nact = 0; qmax = 0.0_wp; x2max = 0.0_wp
       cmean = 0.0_wp
       xlo = huge(1.0_wp); xhi = -huge(1.0_wp)
-      do a = 1, nc
-        x2 = sum(dN(1:nd, a)**2)
-        q = gam(a) * x2
-        if (q <= cut) then
-          N(a) = 0.0_wp
-          nact = nact + 1
-          qmax = max(qmax, q)
-          x2max = max(x2max, x2)
-          cmean(1:nd) = cmean(1:nd) + dN(1:nd, a)
-          do i = 1, nd
-            xlo(i) = min(xlo(i), dN(i, a))
-            xhi(i) = max(xhi(i), dN(i, a))
-          end do
-        else
-          N(a) = -1.0_wp
-        end if
-      end do
+      if (fast2d) then
+        ! The hot case with scalars: the same expressions as the general loop (same results).
+        do a = 1, nc
+          x2 = dN(1, a)**2 + dN(2, a)**2
+          q = gamma * x2
+          if (q <= cut) then
+            N(a) = 0.0_wp
+            nact = nact + 1
+            qmax = max(qmax, q)
+            x2max = max(x2max, x2)
+            cmean(1) = cmean(1) + dN(1, a)
+            cmean(2) = cmean(2) + dN(2, a)
+            xlo(1) = min(xlo(1), dN(1, a))
+            xhi(1) = max(xhi(1), dN(1, a))
+            xlo(2) = min(xlo(2), dN(2, a))
+            xhi(2) = max(xhi(2), dN(2, a))
+          else
+            N(a) = -1.0_wp
+          end if
+        end do
+      else
+        do a = 1, nc
+          x2 = sum(dN(1:nd, a)**2)
+          q = gam(a) * x2
+          if (q <= cut) then
+            N(a) = 0.0_wp
+            nact = nact + 1
+            qmax = max(qmax, q)
+            x2max = max(x2max, x2)
+            cmean(1:nd) = cmean(1:nd) + dN(1:nd, a)
+            do i = 1, nd
+              xlo(i) = min(xlo(i), dN(i, a))
+              xhi(i) = max(xhi(i), dN(i, a))
+            end do
+          else
+            N(a) = -1.0_wp
+          end if
+        end do
+      end if
       ximax = sqrt(x2max)
       ! Direct hull tests: d+1 nodes, x in their bounding box, not all in one hyperplane.
       if (nact < nd + 1) then
@@ -549,13 +580,26 @@ contains
       end do
       cmean = cmean / nact
       cov = 0.0_wp
-      do a = 1, nc
-        if (N(a) < 0.0_wp) cycle
-        y(1:nd) = dN(1:nd, a) - cmean(1:nd)
-        do i = 1, nd
-          cov(1:nd, i) = cov(1:nd, i) + y(1:nd) * y(i)
+      if (nd == 2) then
+        ! As the general loop; cov(1, 2) = cov(2, 1) exactly there too (y1 y2 = y2 y1).
+        do a = 1, nc
+          if (N(a) < 0.0_wp) cycle
+          y(1) = dN(1, a) - cmean(1)
+          y(2) = dN(2, a) - cmean(2)
+          cov(1, 1) = cov(1, 1) + y(1) * y(1)
+          cov(2, 1) = cov(2, 1) + y(2) * y(1)
+          cov(2, 2) = cov(2, 2) + y(2) * y(2)
         end do
-      end do
+        cov(1, 2) = cov(2, 1)
+      else
+        do a = 1, nc
+          if (N(a) < 0.0_wp) cycle
+          y(1:nd) = dN(1:nd, a) - cmean(1:nd)
+          do i = 1, nd
+            cov(1:nd, i) = cov(1:nd, i) + y(1:nd) * y(i)
+          end do
+        end do
+      end if
       cov = cov / nact
       call sym_inverse(nd, cov, cinv, scl, FLAT_COND_MAX, ok)
       if (.not. ok) then
@@ -635,28 +679,50 @@ contains
       ! s = Σp̃ below removes; from here N holds p̃ (0 for inactive candidates).
       qvalid = .false.
       s = 0.0_wp; rt = 0.0_wp; jt = 0.0_wp; bm = 0.0_wp; mv = 0.0_wp
-      do a = 1, nc
-        if (N(a) < 0.0_wp) then
-          N(a) = 0.0_wp
-          cycle
-        end if
-        v(1:nd) = dN(1:nd, a) - r(1:nd)
-        p = N(a) * (1.0_wp + dot_product(v(1:nd), del(1:nd)))
-        N(a) = p
-        s = s + p
-        v(1:nd) = dN(1:nd, a) - cen(1:nd)
-        rt(1:nd) = rt(1:nd) + p * v(1:nd)
-        do i = 1, nd
-          jt(1:nd, i) = jt(1:nd, i) + (p * v(i)) * v(1:nd)
+      if (fast2d) then
+        ! The hot case with scalars: the same expressions as the general loop (same results;
+        ! jt(1, 2) and jt(2, 1) may differ in the last bit, as there).
+        do a = 1, nc
+          if (N(a) < 0.0_wp) then
+            N(a) = 0.0_wp
+            cycle
+          end if
+          p = N(a) * (1.0_wp + ((dN(1, a) - r(1)) * del(1) + (dN(2, a) - r(2)) * del(2)))
+          N(a) = p
+          s = s + p
+          v(1) = dN(1, a) - cen(1)
+          v(2) = dN(2, a) - cen(2)
+          rt(1) = rt(1) + p * v(1)
+          rt(2) = rt(2) + p * v(2)
+          jt(1, 1) = jt(1, 1) + (p * v(1)) * v(1)
+          jt(2, 1) = jt(2, 1) + (p * v(1)) * v(2)
+          jt(1, 2) = jt(1, 2) + (p * v(2)) * v(1)
+          jt(2, 2) = jt(2, 2) + (p * v(2)) * v(2)
         end do
-        if (varying) then
-          ga = p * gam(a)
-          mv(1:nd) = mv(1:nd) + ga * dN(1:nd, a)
+      else
+        do a = 1, nc
+          if (N(a) < 0.0_wp) then
+            N(a) = 0.0_wp
+            cycle
+          end if
+          v(1:nd) = dN(1:nd, a) - r(1:nd)
+          p = N(a) * (1.0_wp + dot_product(v(1:nd), del(1:nd)))
+          N(a) = p
+          s = s + p
+          v(1:nd) = dN(1:nd, a) - cen(1:nd)
+          rt(1:nd) = rt(1:nd) + p * v(1:nd)
           do i = 1, nd
-            bm(1:nd, i) = bm(1:nd, i) + ga * dN(1:nd, a) * dN(i, a)
+            jt(1:nd, i) = jt(1:nd, i) + (p * v(i)) * v(1:nd)
           end do
-        end if
-      end do
+          if (varying) then
+            ga = p * gam(a)
+            mv(1:nd) = mv(1:nd) + ga * dN(1:nd, a)
+            do i = 1, nd
+              bm(1:nd, i) = bm(1:nd, i) + ga * dN(1:nd, a) * dN(i, a)
+            end do
+          end if
+        end do
+      end if
       lh = lh + del
       rt = rt / s
       r = cen + rt
@@ -671,22 +737,40 @@ contains
       jinv = jinv / scl
       ! Gradients (see the module documentation), with the normalised p̃.
       v = 0.0_wp
-      do a = 1, nc
-        if (N(a) == 0.0_wp) then
-          dN(1:nd, a) = 0.0_wp
-          cycle
-        end if
-        N(a) = N(a) / s
-        v(1:nd) = dN(1:nd, a) - r(1:nd)
-        y = matvec(nd, jinv, v)
-        if (varying) then
-          v = matvec(nd, bm, y)
-          dN(1:nd, a) = N(a) * (-y(1:nd) + 2.0_wp * (v(1:nd) - gam(a) * dN(1:nd, a) + &
-                        mv(1:nd))) / h
-        else
-          dN(1:nd, a) = -N(a) * y(1:nd) / h
-        end if
-      end do
+      if (fast2d) then
+        ! The hot case with scalars, as the general loop below.
+        do a = 1, nc
+          if (N(a) == 0.0_wp) then
+            dN(1, a) = 0.0_wp
+            dN(2, a) = 0.0_wp
+            cycle
+          end if
+          N(a) = N(a) / s
+          v(1) = dN(1, a) - r(1)
+          v(2) = dN(2, a) - r(2)
+          y(1) = jinv(1, 1) * v(1) + jinv(1, 2) * v(2)
+          y(2) = jinv(2, 1) * v(1) + jinv(2, 2) * v(2)
+          dN(1, a) = -N(a) * y(1) / h
+          dN(2, a) = -N(a) * y(2) / h
+        end do
+      else
+        do a = 1, nc
+          if (N(a) == 0.0_wp) then
+            dN(1:nd, a) = 0.0_wp
+            cycle
+          end if
+          N(a) = N(a) / s
+          v(1:nd) = dN(1:nd, a) - r(1:nd)
+          y = matvec(nd, jinv, v)
+          if (varying) then
+            v = matvec(nd, bm, y)
+            dN(1:nd, a) = N(a) * (-y(1:nd) + 2.0_wp * (v(1:nd) - gam(a) * dN(1:nd, a) + &
+                          mv(1:nd))) / h
+          else
+            dN(1:nd, a) = -N(a) * y(1:nd) / h
+          end if
+        end do
+      end if
       lam(1:nd) = lh(1:nd) / h
     end block main
     ! On a singular J or no convergence, test whether x is outside the hull: λ·ξ_a < 0 for every
@@ -846,7 +930,7 @@ contains
     real(wp), intent(out) :: c(3)              !! centre of the moments (ξ of the heaviest node)
     real(wp), intent(in), optional :: gnode(:) !! γ per grid node
     integer, intent(in), optional :: node(:)   !! grid node of each candidate
-    real(wp) :: fmax, f, e, s, sr(3), sj(3, 3), u(3)
+    real(wp) :: fmax, f, e, s, sr(3), sj(3, 3), u(3), fa(MOM_BUF)
     integer :: a, i, amax
     logical :: varying
     varying = present(gnode) .and. present(node)
@@ -854,13 +938,15 @@ contains
     amax = 0
     s = 0.0_wp; sr = 0.0_wp; sj = 0.0_wp; u = 0.0_wp
     c = 0.0_wp
-    if (nd == 2 .and. .not. varying) then
+    if (nd == 2 .and. .not. varying .and. nc <= MOM_BUF) then
       ! The hot case, with scalars: the same expressions as the general loop below (same
-      ! results), without its short assumed-shape loops.
+      ! results), without its short assumed-shape loops; the exponents are kept for the
+      ! second pass rather than recomputed.
       do a = 1, nc
         if (w(a) < 0.0_wp) cycle
         f = -(gamma * (xi(1, a) * xi(1, a) + xi(2, a) * xi(2, a))) + &
             (lh(1) * xi(1, a) + lh(2) * xi(2, a))
+        fa(a) = f
         if (f > fmax) then
           fmax = f
           amax = a
@@ -869,8 +955,7 @@ contains
       if (amax > 0) c(1:2) = xi(1:2, amax)
       do a = 1, nc
         if (w(a) < 0.0_wp) cycle
-        e = exp(-(gamma * (xi(1, a) * xi(1, a) + xi(2, a) * xi(2, a))) + &
-                (lh(1) * xi(1, a) + lh(2) * xi(2, a)) - fmax)
+        e = exp(fa(a) - fmax)
         w(a) = e
         s = s + e
         u(1) = xi(1, a) - c(1)
@@ -941,6 +1026,20 @@ contains
     na = frob(nd, a)
     if (.not. (na > 0.0_wp .and. na <= huge(na))) return
     ! Only the leading block is formed: b and adj beyond it are never read.
+    if (nd == 2) then
+      ! 2D with scalars (the hot case): the same expressions as the general code below.
+      b(1, 1) = a(1, 1) / na; b(1, 2) = a(1, 2) / na; b(2, 2) = a(2, 2) / na
+      adj(1, 1) = b(2, 2); adj(2, 2) = b(1, 1)
+      adj(1, 2) = -b(1, 2); adj(2, 1) = -b(1, 2)
+      det = b(1, 1) * b(2, 2) - b(1, 2) * b(1, 2)
+      nadj = frob(2, adj)
+      ok = det > 0.0_wp .and. det * cond_max > nadj
+      if (ok) then
+        ainv(1, 1) = adj(1, 1) / det; ainv(2, 1) = adj(2, 1) / det
+        ainv(1, 2) = adj(1, 2) / det; ainv(2, 2) = adj(2, 2) / det
+      end if
+      return
+    end if
     b(1:nd, 1:nd) = a(1:nd, 1:nd) / na
     select case (nd)
     case (1)
@@ -972,12 +1071,17 @@ contains
     real(wp), intent(in) :: a(3, 3)  !! matrix
     real(wp) :: ss
     integer :: i, j
-    ss = 0.0_wp
-    do j = 1, nd
-      do i = 1, nd
-        ss = ss + a(i, j)**2
+    if (nd == 2) then
+      ! Same order as the loops (0 + a11² = a11² exactly).
+      ss = a(1, 1)**2 + a(2, 1)**2 + a(1, 2)**2 + a(2, 2)**2
+    else
+      ss = 0.0_wp
+      do j = 1, nd
+        do i = 1, nd
+          ss = ss + a(i, j)**2
+        end do
       end do
-    end do
+    end if
     if (ss > SUMSQ_LO .and. ss < SUMSQ_HI) then
       frob = sqrt(ss)
     else
@@ -991,10 +1095,14 @@ contains
     real(wp), intent(in) :: v(3)     !! vector
     real(wp) :: ss
     integer :: i
-    ss = 0.0_wp
-    do i = 1, nd
-      ss = ss + v(i)**2
-    end do
+    if (nd == 2) then
+      ss = v(1)**2 + v(2)**2
+    else
+      ss = 0.0_wp
+      do i = 1, nd
+        ss = ss + v(i)**2
+      end do
+    end if
     if (ss > SUMSQ_LO .and. ss < SUMSQ_HI) then
       norm_small = sqrt(ss)
     else
@@ -1011,6 +1119,13 @@ contains
     real(wp), intent(in) :: v(3)     !! vector
     real(wp) :: y(3)                 !! product (zero beyond nd)
     integer :: i, j
+    if (nd == 2) then
+      ! The loops' sums in the same order (up to the sign of a zero result).
+      y(1) = a(1, 1) * v(1) + a(1, 2) * v(2)
+      y(2) = a(2, 1) * v(1) + a(2, 2) * v(2)
+      y(3) = 0.0_wp
+      return
+    end if
     y = 0.0_wp
     do j = 1, nd
       do i = 1, nd
