@@ -78,7 +78,7 @@ contains
     class(empm_integrator_t), intent(inout) :: self !! integrator (body-force scratch)
     type(empm_model_t), intent(inout) :: model      !! simulation state
     type(empm_step_status_t) :: stat
-    call eval_basis(model, stat)
+    call eval_basis(model, stat, ws=self%p2g)
     if (stat%code /= 0) return
     call model%nodes%reset()
     call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
@@ -89,10 +89,12 @@ contains
 
   !> Evaluate shape functions at the current particle positions (one batched call). With
   !> `timer`, Newton iterations of LME bases are counted in it.
-  subroutine eval_basis(model, stat, timer)
+  subroutine eval_basis(model, stat, timer, ws)
     type(empm_model_t), intent(inout) :: model               !! simulation state
     type(empm_step_status_t), intent(inout) :: stat          !! set on failure
     type(empm_phase_timer_t), intent(inout), optional :: timer !! iteration counters
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace: its
+                                                             !! node ranges follow the new basis
     integer :: ibad, info, iters
     if (present(timer)) then
       call model%shape%eval_batch_iters(model%grid, model%pts, model%basis, ibad, info, iters)
@@ -103,6 +105,8 @@ contains
     end if
     if (info /= 0) then
       stat%code = STEP_SHAPE_FAILED; stat%detail = info; stat%particle = ibad
+    else if (present(ws)) then
+      call ws%set_ranges(model%basis)
     end if
   end subroutine eval_basis
 

@@ -52,7 +52,7 @@ contains
     type(empm_step_status_t), intent(out) :: stat   !! outcome
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
       call tm%mark()
-      call eval_basis(model, stat, tm)
+      call eval_basis(model, stat, tm, self%p2g)
       call tm%lap(PHASE_SHAPE)
       if (stat%code /= STEP_OK) return
       call nodes%reset()

@@ -68,7 +68,7 @@ contains
     call genalpha_parameters(self%rho_b, am, be, ga)
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
       call tm%mark()
-      call eval_basis(model, stat, tm)
+      call eval_basis(model, stat, tm, self%p2g)
       call tm%lap(PHASE_SHAPE)
       if (stat%code /= STEP_OK) return
       call nodes%reset()

@@ -26,10 +26,12 @@ module empm_transfer
   type :: empm_p2g_work_t
     integer :: nt = 1                       !! particle chunks (threads); 1 = serial
     real(wp), allocatable :: buf(:,:,:)     !! accumulators of chunks 2..nt (ndim, nnode, nt-1)
-    integer, allocatable :: lo(:)           !! first node touched by each chunk (nt)
+    integer, allocatable :: lo(:)           !! first node touched by each chunk (nt); set by
+                                            !! set_ranges after every basis evaluation
     integer, allocatable :: hi(:)           !! last node touched by each chunk (nt)
   contains
     procedure :: init => p2g_work_init
+    procedure :: set_ranges => p2g_work_set_ranges
   end type empm_p2g_work_t
 
 contains
@@ -49,6 +51,22 @@ contains
     self%buf = 0.0_wp
     self%lo = 1; self%hi = 0
   end subroutine p2g_work_init
+
+  !> Record the node range touched by each particle chunk for the current basis. The basis
+  !> changes once per step, so this runs once per step (after the shape functions) instead of
+  !> in every P2G call; the chunks' ranges are computed in parallel.
+  subroutine p2g_work_set_ranges(self, basis)
+    class(empm_p2g_work_t), intent(inout) :: self !! workspace
+    type(empm_basis_t), intent(in) :: basis       !! shape functions at the particles
+    integer :: c, p0, p1
+    if (self%nt <= 1) return
+    !$omp parallel do num_threads(self%nt) schedule(static, 1) private(p0, p1)
+    do c = 2, self%nt
+      call chunk_bounds(basis%np, self%nt, c - 1, p0, p1)
+      call node_range(basis, p0, p1, self%lo(c), self%hi(c))
+    end do
+    !$omp end parallel do
+  end subroutine p2g_work_set_ranges
 
   !> Particles p0..p1 of chunk c (0-based) of n chunks over np particles.
   pure subroutine chunk_bounds(np, n, c, p0, p1)
@@ -126,7 +144,6 @@ contains
       if (c == 1) then
         call mass_range(basis, m, p0, p1, mass)
       else
-        call node_range(basis, p0, p1, ws%lo(c), ws%hi(c))
         call mass_range(basis, m, p0, p1, ws%buf(1, :, c - 1))
       end if
     end do
@@ -171,7 +188,6 @@ contains
       if (ic == 1) then
         call weighted_range(basis, m, u, c, w, p0, p1, q)
       else
-        call node_range(basis, p0, p1, ws%lo(ic), ws%hi(ic))
         call weighted_range(basis, m, u, c, w, p0, p1, ws%buf(:, :, ic - 1))
       end if
     end do
@@ -220,7 +236,6 @@ contains
       if (c == 1) then
         call internal_range(basis, vol, stress, p0, p1, f)
       else
-        call node_range(basis, p0, p1, ws%lo(c), ws%hi(c))
         call internal_range(basis, vol, stress, p0, p1, ws%buf(:, :, c - 1))
       end if
     end do
@@ -281,7 +296,6 @@ contains
       if (c == 1) then
         call body_range(basis, m, g, b, use_b, p0, p1, f)
       else
-        call node_range(basis, p0, p1, ws%lo(c), ws%hi(c))
         call body_range(basis, m, g, b, use_b, p0, p1, ws%buf(:, :, c - 1))
       end if
     end do
@@ -402,11 +416,12 @@ contains
   end subroutine velocity_gradient
 
   !> out_I = q_I / m_I on nodes with mass above the empty-node threshold, 0 elsewhere.
-  pure subroutine nodal_divide_by_mass(nodes, q, out)
+  subroutine nodal_divide_by_mass(nodes, q, out)
     type(empm_nodes_t), intent(in) :: nodes !! nodal fields (mass, mass_tol)
     real(wp), intent(in) :: q(:,:)          !! nodal vectors (ndim, nnode)
     real(wp), intent(out) :: out(:,:)       !! q/m (ndim, nnode)
     integer :: I
+    !$omp parallel do schedule(static) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
     do I = 1, nodes%nnode
       if (nodes%mass(I) > nodes%mass_tol) then
         out(:, I) = q(:, I) / nodes%mass(I)
@@ -414,20 +429,23 @@ contains
         out(:, I) = 0.0_wp
       end if
     end do
+    !$omp end parallel do
   end subroutine nodal_divide_by_mass
 
   !> Impose Dirichlet conditions on nodal velocity (and the matching momentum).
-  pure subroutine constrain_velocity(nodes, v, mom)
+  subroutine constrain_velocity(nodes, v, mom)
     type(empm_nodes_t), intent(in) :: nodes   !! nodal constraints and masses
     real(wp), intent(inout) :: v(:,:)         !! nodal velocities (ndim, nnode)
     real(wp), intent(inout) :: mom(:,:)       !! nodal momenta (ndim, nnode)
     integer :: I
+    !$omp parallel do schedule(static) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
     do I = 1, nodes%nnode
       where (nodes%fixed(:, I))
         v(:, I) = nodes%vfix(:, I)
         mom(:, I) = nodes%mass(I) * nodes%vfix(:, I)
       end where
     end do
+    !$omp end parallel do
   end subroutine constrain_velocity
 
   !> Zero nodal forces on fixed dofs (zero acceleration there).
