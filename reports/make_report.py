@@ -194,10 +194,24 @@ def andersen_section(s):
             ye = np.linspace(0, 10, 50)
     a2.plot(-6000 * 9.81 * (10 - ye) / 1e6, ye, "k-", lw=1.5, label="static exact")
     a1.axhline(-0.5886, color="k", ls="--", lw=1, label="small-strain static")
+    fig2, a3 = plt.subplots(figsize=(7, 3.8))
+    for c in cases:
+        with h5(c["output"]) as f:
+            a3.plot(f["/probes/base/time"][:], f["/probes/base/stress"][:, 1] / 1e6, lw=0.9,
+                    label=c["id"].split("/", 1)[1])
+            if c is cases[0]:
+                a3.plot(f["/probes/base/time"][:],
+                        f["/verification/probe_base/stress"][:, 1] / 1e6, "k-", lw=1.5,
+                        label="exact column (at the particle's height)")
+    a3.set_xlabel("t [s]"); a3.set_ylabel("σ_yy at the base particle [MPa]"); a3.grid(alpha=0.3)
+    a3.legend(fontsize=6)
+    fig12 = savefig(fig2, "andersen_base_stress.png")
     a1.set_xlabel("t [s]"); a1.set_ylabel("top displacement [m]"); a1.grid(alpha=0.3)
     a2.set_xlabel("σ_yy [MPa]"); a2.set_ylabel("Y (reference height) [m]"); a2.grid(alpha=0.3)
     a1.legend(fontsize=6); a2.legend(fontsize=6)
-    out += [f"![Andersen block]({savefig(fig, 'andersen.png')})", ""]
+    out += [f"![Andersen block]({savefig(fig, 'andersen.png')})", "",
+            "Vertical stress of the base material point against time (the paper's figure 12):", "",
+            f"![Andersen base stress]({fig12})", ""]
     stable = [c for c in cases if c["passed"] and not c.get("expected_failure")]
     failed = [c for c in cases if c.get("expected_failure")]
     out += ["**The paper's claim, checked.** Within the thresholds (stress profile and base stress "
@@ -271,6 +285,24 @@ def main():
         lines += ["## Integrator stability and LME basis", ""]
         for p, t in present:
             lines += [f"{t}:", "", f"![{t}]({p})", ""]
+    lines += ["## Where our numbers disagree with the paper", "",
+              "- **Base stress of the Andersen block**: ρgH = 6000 × 9.81 × 10 = 0.5886 MPa; the "
+              "paper's 5.2 MPa follows from no combination of its data (erratum; our runs "
+              "oscillate about 0.5886 MPa at the base).",
+              "- **Where the predictor-corrector's smoothing comes from**: the published particle "
+              "update (eqs. 33–35) is first order in time (measured 1.05 on the manufactured "
+              "solution, 1.04 on the vibrating bar) and numerically damped (spectral radius "
+              "sqrt(1 − Ω²/2)); it removes the Dyka overshoot by damping. The "
+              "Newmark-consistent update (second order, 2.0) oscillates like forward Euler. The "
+              "paper credits the predictor-corrector itself.",
+              "- **Eq. (33)** as printed (a_p^{k+1} = a_p^n + N f/m) is a typo; we use "
+              "a_p^{k+1} = Σ N f_I/m_I.",
+              "- **Q4 in the Andersen block**: we reproduce the instability (growing, erratic "
+              "settlement with pc_newmark after about 11 s; large stress errors with "
+              "pc_published), and LME γ = 0.8 and 3 and uGIMP stay within the thresholds, as the "
+              "paper says.",
+              "- **The Dyka figures' \"left side\"** is the free end x = L in our (and the paper's "
+              "section 6.1) coordinates; the paper's figures use the mirrored bar.", ""]
     lines += ["## Summary of every check", "", summary_table(s), ""]
     with open(os.path.join(HERE, "README.md"), "w") as f:
         f.write("\n".join(lines) + "\n")

@@ -23,6 +23,9 @@ module funit
   ! runner API, used by the code funitproc_lite.py generates
   public :: funit_lite_test_proc, funit_lite_run_test
   public :: funit_lite_reset, funit_lite_num_failures, funit_lite_failure
+  ! Names that pFUnit's `funit` module also exports: reserved here, so that a .pf module that
+  ! defines one of them (e.g. a helper called `run`) fails under funit-lite as under pFUnit.
+  public :: initialize, run, finalize, stub
 
   integer, parameter :: MAXLEN_FILE_NAME = 255   !! as pFUnit's SourceLocation
   integer, parameter :: MAXLEN_MESSAGE = 2048    !! longer failure messages are truncated
@@ -930,4 +933,24 @@ contains
                                                      real_str(x), message, location)
   end subroutine assert_is_finite_r
 
+
+  !> Reserved pFUnit name (see the public list); not part of the funit-lite subset.
+  subroutine initialize()
+    error stop 'funit-lite: initialize is a pFUnit name, not part of the supported subset'
+  end subroutine initialize
+
+  !> Reserved pFUnit name (see the public list); not part of the funit-lite subset.
+  subroutine run()
+    error stop 'funit-lite: run is a pFUnit name, not part of the supported subset'
+  end subroutine run
+
+  !> Reserved pFUnit name (see the public list); not part of the funit-lite subset.
+  subroutine finalize()
+    error stop 'funit-lite: finalize is a pFUnit name, not part of the supported subset'
+  end subroutine finalize
+
+  !> Reserved pFUnit name (see the public list); not part of the funit-lite subset.
+  subroutine stub()
+    error stop 'funit-lite: stub is a pFUnit name, not part of the supported subset'
+  end subroutine stub
 end module funit
