@@ -449,9 +449,14 @@ contains
   end subroutine constrain_velocity
 
   !> Zero nodal forces on fixed dofs (zero acceleration there).
-  pure subroutine constrain_force(nodes, f)
+  subroutine constrain_force(nodes, f)
     type(empm_nodes_t), intent(in) :: nodes !! nodal constraints
     real(wp), intent(inout) :: f(:,:)       !! nodal forces (ndim, nnode)
-    where (nodes%fixed) f = 0.0_wp
+    integer :: I
+    !$omp parallel do schedule(static) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
+    do I = 1, nodes%nnode
+      where (nodes%fixed(:, I)) f(:, I) = 0.0_wp
+    end do
+    !$omp end parallel do
   end subroutine constrain_force
 end module empm_transfer
