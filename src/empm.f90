@@ -29,6 +29,7 @@ module empm
   use empm_output, only: empm_write_results, empm_output_meta_t
   use empm_driver, only: empm_run_case
   use empm_exact_bar, only: empm_vibrating_bar_t
+  use empm_mms, only: empm_mms_t
   use empm_spectrum, only: empm_power_spectrum, empm_energy_share_above
   use empm_linalg, only: empm_eigenvalues, empm_spectral_radius
   implicit none
@@ -53,6 +54,6 @@ module empm
   public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
   public :: empm_write_results, empm_output_meta_t, empm_run_case
   ! Analysis: exact solutions, spectra, eigenvalues
-  public :: empm_vibrating_bar_t, empm_power_spectrum, empm_energy_share_above
+  public :: empm_vibrating_bar_t, empm_mms_t, empm_power_spectrum, empm_energy_share_above
   public :: empm_eigenvalues, empm_spectral_radius
 end module empm

@@ -1,6 +1,6 @@
 !> Manufactured solutions for small-strain isotropic linear elasticity (docs/algorithms §3),
 !> for measuring spatial and temporal rates without large-deformation effects. Each type is
-!> its own body force (it extends [[empm_body_force_t]]): give it to `loads%body_force`.
+!> its own body force (it extends [[empm_mms_t]], a body force): give it to `loads%body_force`.
 !>
 !> Small strain: ρ ü = div σ + ρ b with σ = λ tr(ε) I + 2μ ε, ε = sym ∇u, all derivatives taken
 !> in the reference configuration and b evaluated at the particle's reference position X
@@ -26,7 +26,7 @@
 !> The derivation is checked by finite differences in tests/unit/test_exact_mms.pf.
 module empm_mms_linear
   use empm_kinds, only: wp, pi
-  use empm_loads, only: empm_body_force_t
+  use empm_mms, only: empm_mms_t
   use empm_material_linear_elastic, only: empm_lame
   use empm_tensor, only: identity3
   implicit none
@@ -34,7 +34,7 @@ module empm_mms_linear
   public :: empm_mms_linear_1d_t, empm_mms_linear_2d_t
 
   !> 1D small-strain manufactured solution u = A sin(2πX/L) sin(2πt/T0), both ends fixed.
-  type, extends(empm_body_force_t) :: empm_mms_linear_1d_t
+  type, extends(empm_mms_t) :: empm_mms_linear_1d_t
     real(wp) :: L = 1.0_wp         !! bar length [m]
     real(wp) :: E = 1.0e4_wp       !! Young's modulus [Pa]
     real(wp) :: nu = 0.0_wp        !! Poisson's ratio (uniaxial strain: M = λ + 2μ)
@@ -49,11 +49,11 @@ module empm_mms_linear
     procedure :: def_grad => l1_def_grad
     procedure :: stress => l1_stress
     procedure :: body_force => l1_body_force
-    procedure :: eval => l1_eval
+    procedure :: fields => l1_fields
   end type empm_mms_linear_1d_t
 
   !> 2D plane-strain small-strain manufactured solution on [0, L]², all sides fixed.
-  type, extends(empm_body_force_t) :: empm_mms_linear_2d_t
+  type, extends(empm_mms_t) :: empm_mms_linear_2d_t
     real(wp) :: L = 1.0_wp         !! side of the square [m]
     real(wp) :: E = 1.0e4_wp       !! Young's modulus [Pa]
     real(wp) :: nu = 0.3_wp        !! Poisson's ratio
@@ -67,7 +67,7 @@ module empm_mms_linear
     procedure :: def_grad => l2_def_grad
     procedure :: stress => l2_stress
     procedure :: body_force => l2_body_force
-    procedure :: eval => l2_eval
+    procedure :: fields => l2_fields
   end type empm_mms_linear_2d_t
 
 contains
@@ -147,21 +147,20 @@ contains
          - (2.0_wp * pi / self%period)**2) * self%displacement(X, t)
   end function l1_body_force
 
-  !> [[empm_body_force_t]] binding: b at the reference positions; components beyond x are 0.
-  pure subroutine l1_eval(self, t, x0, x, b)
+  !> [[empm_mms_t]] binding: every exact field at one reference point.
+  pure subroutine l1_fields(self, X, t, u, v, F, s, b)
     class(empm_mms_linear_1d_t), intent(in) :: self !! solution
-    real(wp), intent(in) :: t                       !! time [s]
-    real(wp), intent(in) :: x0(:,:)                 !! reference positions (ndim, n) [m]
-    real(wp), intent(in) :: x(:,:)                  !! current positions (ndim, n), unused
-    real(wp), intent(out) :: b(:,:)                 !! body force per unit mass (ndim, n)
-    integer :: p
-    b = 0.0_wp
-    do p = 1, size(x0, 2)
-      b(1:1, p) = self%body_force(x0(1:1, p), t)
-    end do
-    associate (unused => x) ! evaluated at reference positions by construction
-    end associate
-  end subroutine l1_eval
+    real(wp), intent(in) :: X(:)          !! reference position (1) [m]
+    real(wp), intent(in) :: t             !! time [s]
+    real(wp), intent(out) :: u(:)         !! displacement [m]
+    real(wp), intent(out) :: v(:)         !! velocity [m/s]
+    real(wp), intent(out) :: F(3,3)       !! deformation gradient
+    real(wp), intent(out) :: s(6)         !! Cauchy stress, Voigt [Pa]
+    real(wp), intent(out) :: b(:)         !! body force per unit mass [m/s²]
+    u = self%displacement(X(1:1), t); v = self%velocity(X(1:1), t)
+    F = self%def_grad(X(1:1), t); s = self%stress(X(1:1), t)
+    b = self%body_force(X(1:1), t)
+  end subroutine l1_fields
 
   ! ---- 2D plane strain ------------------------------------------------------------------------
 
@@ -247,21 +246,20 @@ contains
     b = self%acceleration(X, t) - divs / self%rho
   end function l2_body_force
 
-  !> [[empm_body_force_t]] binding: b at the reference positions; components beyond x, y are 0.
-  pure subroutine l2_eval(self, t, x0, x, b)
+  !> [[empm_mms_t]] binding: every exact field at one reference point.
+  pure subroutine l2_fields(self, X, t, u, v, F, s, b)
     class(empm_mms_linear_2d_t), intent(in) :: self !! solution
-    real(wp), intent(in) :: t                       !! time [s]
-    real(wp), intent(in) :: x0(:,:)                 !! reference positions (ndim >= 2, n) [m]
-    real(wp), intent(in) :: x(:,:)                  !! current positions (ndim, n), unused
-    real(wp), intent(out) :: b(:,:)                 !! body force per unit mass (ndim, n)
-    integer :: p
-    b = 0.0_wp
-    do p = 1, size(x0, 2)
-      b(1:2, p) = self%body_force(x0(1:2, p), t)
-    end do
-    associate (unused => x) ! evaluated at reference positions by construction
-    end associate
-  end subroutine l2_eval
+    real(wp), intent(in) :: X(:)          !! reference position (2) [m]
+    real(wp), intent(in) :: t             !! time [s]
+    real(wp), intent(out) :: u(:)         !! displacement [m]
+    real(wp), intent(out) :: v(:)         !! velocity [m/s]
+    real(wp), intent(out) :: F(3,3)       !! deformation gradient
+    real(wp), intent(out) :: s(6)         !! Cauchy stress, Voigt [Pa]
+    real(wp), intent(out) :: b(:)         !! body force per unit mass [m/s²]
+    u = self%displacement(X(1:2), t); v = self%velocity(X(1:2), t)
+    F = self%def_grad(X(1:2), t); s = self%stress(X(1:2), t)
+    b = self%body_force(X(1:2), t)
+  end subroutine l2_fields
 
   !> Spatial shapes (sin aX sin aY, sin 2aX sin aY), a = π/L.
   pure function shape2(self, X) result(f)

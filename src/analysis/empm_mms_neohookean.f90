@@ -1,7 +1,7 @@
 !> Large-deformation manufactured solutions for the compressible neo-Hookean law of
 !> [[empm_material_neohookean]] (docs/algorithms §3): the 1D problem of Steffen, Kirby &
 !> Berzins (2008) and the 2D axis-aligned displacement of Wallstedt & Guilkey (2008). Each type
-!> is its own body force (it extends [[empm_body_force_t]]): give it to `loads%body_force`.
+!> is its own body force (it extends [[empm_mms_t]], a body force): give it to `loads%body_force`.
 !>
 !> Total Lagrangian momentum balance ρ0 ü = Div P + ρ0 b, with P = J σ F⁻ᵀ the first Piola
 !> stress, Div the reference divergence and b evaluated at the particle's reference position X.
@@ -26,7 +26,7 @@
 !> The derivation is checked by finite differences of P in tests/unit/test_exact_mms.pf.
 module empm_mms_neohookean
   use empm_kinds, only: wp, pi
-  use empm_loads, only: empm_body_force_t
+  use empm_mms, only: empm_mms_t
   use empm_material_linear_elastic, only: empm_lame
   use empm_tensor, only: identity3
   implicit none
@@ -34,7 +34,7 @@ module empm_mms_neohookean
   public :: empm_mms_neohookean_1d_t, empm_mms_axis_aligned_2d_t
 
   !> 1D neo-Hookean manufactured solution of Steffen et al. (2008).
-  type, extends(empm_body_force_t) :: empm_mms_neohookean_1d_t
+  type, extends(empm_mms_t) :: empm_mms_neohookean_1d_t
     real(wp) :: L = 1.0_wp       !! bar length [m]
     real(wp) :: E = 1.0e4_wp     !! small-strain Young's modulus [Pa]
     real(wp) :: nu = 0.3_wp      !! small-strain Poisson's ratio
@@ -47,11 +47,11 @@ module empm_mms_neohookean
     procedure :: def_grad => n1_def_grad
     procedure :: stress => n1_stress
     procedure :: body_force => n1_body_force
-    procedure :: eval => n1_eval
+    procedure :: fields => n1_fields
   end type empm_mms_neohookean_1d_t
 
   !> 2D axis-aligned neo-Hookean manufactured solution of Wallstedt & Guilkey (2008).
-  type, extends(empm_body_force_t) :: empm_mms_axis_aligned_2d_t
+  type, extends(empm_mms_t) :: empm_mms_axis_aligned_2d_t
     real(wp) :: L = 1.0_wp       !! side of the square [m]
     real(wp) :: E = 1.0e4_wp     !! small-strain Young's modulus [Pa]
     real(wp) :: nu = 0.3_wp      !! small-strain Poisson's ratio
@@ -64,7 +64,7 @@ module empm_mms_neohookean
     procedure :: def_grad => n2_def_grad
     procedure :: stress => n2_stress
     procedure :: body_force => n2_body_force
-    procedure :: eval => n2_eval
+    procedure :: fields => n2_fields
   end type empm_mms_axis_aligned_2d_t
 
 contains
@@ -138,21 +138,20 @@ contains
                         F(1,1))
   end function n1_body_force
 
-  !> [[empm_body_force_t]] binding: b at the reference positions; components beyond x are 0.
-  pure subroutine n1_eval(self, t, x0, x, b)
+  !> [[empm_mms_t]] binding: every exact field at one reference point.
+  pure subroutine n1_fields(self, X, t, u, v, F, s, b)
     class(empm_mms_neohookean_1d_t), intent(in) :: self !! solution
-    real(wp), intent(in) :: t                           !! time [s]
-    real(wp), intent(in) :: x0(:,:)                     !! reference positions (ndim, n) [m]
-    real(wp), intent(in) :: x(:,:)                      !! current positions (ndim, n), unused
-    real(wp), intent(out) :: b(:,:)                     !! body force per unit mass (ndim, n)
-    integer :: p
-    b = 0.0_wp
-    do p = 1, size(x0, 2)
-      b(1:1, p) = self%body_force(x0(1:1, p), t)
-    end do
-    associate (unused => x) ! evaluated at reference positions by construction
-    end associate
-  end subroutine n1_eval
+    real(wp), intent(in) :: X(:)          !! reference position (1) [m]
+    real(wp), intent(in) :: t             !! time [s]
+    real(wp), intent(out) :: u(:)         !! displacement [m]
+    real(wp), intent(out) :: v(:)         !! velocity [m/s]
+    real(wp), intent(out) :: F(3,3)       !! deformation gradient
+    real(wp), intent(out) :: s(6)         !! Cauchy stress, Voigt [Pa]
+    real(wp), intent(out) :: b(:)         !! body force per unit mass [m/s²]
+    u = self%displacement(X(1:1), t); v = self%velocity(X(1:1), t)
+    F = self%def_grad(X(1:1), t); s = self%stress(X(1:1), t)
+    b = self%body_force(X(1:1), t)
+  end subroutine n1_fields
 
   !> ω = cπ/L with c = sqrt(E/ρ0) [rad/s].
   pure real(wp) function n1_omega(self)
@@ -240,21 +239,20 @@ contains
     b(2) = u(2) * body_factor(mu, lam, self%rho0, k, w, F(2,2), J)
   end function n2_body_force
 
-  !> [[empm_body_force_t]] binding: b at the reference positions; components beyond x, y are 0.
-  pure subroutine n2_eval(self, t, x0, x, b)
+  !> [[empm_mms_t]] binding: every exact field at one reference point.
+  pure subroutine n2_fields(self, X, t, u, v, F, s, b)
     class(empm_mms_axis_aligned_2d_t), intent(in) :: self !! solution
-    real(wp), intent(in) :: t                             !! time [s]
-    real(wp), intent(in) :: x0(:,:)                       !! reference positions (ndim >= 2, n) [m]
-    real(wp), intent(in) :: x(:,:)                        !! current positions (ndim, n), unused
-    real(wp), intent(out) :: b(:,:)                       !! body force per unit mass (ndim, n)
-    integer :: p
-    b = 0.0_wp
-    do p = 1, size(x0, 2)
-      b(1:2, p) = self%body_force(x0(1:2, p), t)
-    end do
-    associate (unused => x) ! evaluated at reference positions by construction
-    end associate
-  end subroutine n2_eval
+    real(wp), intent(in) :: X(:)          !! reference position (2) [m]
+    real(wp), intent(in) :: t             !! time [s]
+    real(wp), intent(out) :: u(:)         !! displacement [m]
+    real(wp), intent(out) :: v(:)         !! velocity [m/s]
+    real(wp), intent(out) :: F(3,3)       !! deformation gradient
+    real(wp), intent(out) :: s(6)         !! Cauchy stress, Voigt [Pa]
+    real(wp), intent(out) :: b(:)         !! body force per unit mass [m/s²]
+    u = self%displacement(X(1:2), t); v = self%velocity(X(1:2), t)
+    F = self%def_grad(X(1:2), t); s = self%stress(X(1:2), t)
+    b = self%body_force(X(1:2), t)
+  end subroutine n2_fields
 
   !> ω = cπ/L with c = sqrt(E/ρ0) [rad/s].
   pure real(wp) function n2_omega(self)

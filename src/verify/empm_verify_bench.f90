@@ -14,6 +14,7 @@ module empm_verify_bench
   use empm_exact_bar, only: empm_vibrating_bar_t
   use empm_exact_characteristics, only: empm_char_bar_t, empm_dyka_bar
   use empm_exact_column, only: empm_column_t, empm_andersen_column
+  use empm_mms, only: empm_mms_t
   use empm_mms_linear, only: empm_mms_linear_1d_t, empm_mms_linear_2d_t
   use empm_mms_neohookean, only: empm_mms_neohookean_1d_t, empm_mms_axis_aligned_2d_t
   implicit none
@@ -33,10 +34,7 @@ module empm_verify_bench
     type(empm_char_bar_t) :: dyka               !! Dyka bar by characteristics
     type(empm_vibrating_bar_t) :: bar           !! vibrating bar
     type(empm_column_t) :: column               !! self-weight column (Andersen block)
-    type(empm_mms_linear_1d_t) :: ml1           !! linear MMS, 1D
-    type(empm_mms_linear_2d_t) :: ml2           !! linear MMS, 2D
-    type(empm_mms_neohookean_1d_t) :: nh1       !! neo-Hookean MMS, 1D (Steffen)
-    type(empm_mms_axis_aligned_2d_t) :: aa2     !! axis-aligned MMS, 2D (Wallstedt & Guilkey)
+    class(empm_mms_t), allocatable :: mms       !! manufactured solution (mms_* benchmarks)
   contains
     procedure :: prepare => bench_prepare
     procedure :: metric => bench_metric
@@ -67,6 +65,7 @@ contains
     real(wp), intent(out) :: u(size(X))      !! displacement [m]
     real(wp), intent(out) :: v(size(X))      !! velocity [m/s]
     real(wp), intent(out) :: s(6)            !! stress [Pa]
+    real(wp) :: F(3,3), b(size(X))
     u = 0.0_wp; v = 0.0_wp; s = 0.0_wp
     select case (trim(self%id))
     case ('dyka')
@@ -79,14 +78,8 @@ contains
       ! 1D uniaxial-strain column along y (plane strain, rollers, nu = 0).
       u(2) = self%column%displacement(X(2), t); v(2) = self%column%velocity(X(2), t)
       s(2) = self%column%stress(X(2), t)
-    case ('mms_linear_1d')
-      u = self%ml1%displacement(X, t); v = self%ml1%velocity(X, t); s = self%ml1%stress(X, t)
-    case ('mms_linear_2d')
-      u = self%ml2%displacement(X, t); v = self%ml2%velocity(X, t); s = self%ml2%stress(X, t)
-    case ('mms_neohookean_1d')
-      u = self%nh1%displacement(X, t); v = self%nh1%velocity(X, t); s = self%nh1%stress(X, t)
-    case ('mms_axis_aligned_2d')
-      u = self%aa2%displacement(X, t); v = self%aa2%velocity(X, t); s = self%aa2%stress(X, t)
+    case ('mms_linear_1d', 'mms_linear_2d', 'mms_neohookean_1d', 'mms_axis_aligned_2d')
+      call self%mms%fields(X, t, u, v, F, s, b)
     end select
   end subroutine bench_exact
 
@@ -131,31 +124,42 @@ contains
       self%uscale = self%column%settlement()
       self%vscale = self%uscale * 2.0_wp * pi / self%column%period()
     case ('mms_linear_1d')
-      call expect_speed(sqrt(self%ml1%modulus() / self%ml1%rho))
-      call set_initial_state(cs)
-      allocate(cs%model%loads%body_force, source=self%ml1)
-      self%uscale = self%ml1%A; self%vscale = self%ml1%A * 2.0_wp * pi / self%ml1%period
-      self%sscale = self%ml1%E * self%ml1%A * 2.0_wp * pi / self%ml1%L
+      block
+        type(empm_mms_linear_1d_t) :: m
+        call expect_speed(sqrt(m%modulus() / m%rho))
+        self%uscale = m%A; self%vscale = m%A * 2.0_wp * pi / m%period
+        self%sscale = m%E * m%A * 2.0_wp * pi / m%L
+        allocate(self%mms, source=m)
+      end block
     case ('mms_linear_2d')
-      call set_initial_state(cs)
-      allocate(cs%model%loads%body_force, source=self%ml2)
-      self%uscale = self%ml2%A; self%vscale = self%ml2%A * 2.0_wp * pi / self%ml2%period
-      self%sscale = self%ml2%E * self%ml2%A * pi / self%ml2%L
+      block
+        type(empm_mms_linear_2d_t) :: m
+        self%uscale = m%A; self%vscale = m%A * 2.0_wp * pi / m%period
+        self%sscale = m%E * m%A * pi / m%L
+        allocate(self%mms, source=m)
+      end block
     case ('mms_neohookean_1d')
-      call set_initial_state(cs)
-      allocate(cs%model%loads%body_force, source=self%nh1)
-      self%uscale = self%nh1%A
-      self%vscale = self%nh1%A * pi * sqrt(self%nh1%E / self%nh1%rho0) / self%nh1%L
-      self%sscale = self%nh1%E * self%nh1%A * 2.0_wp * pi / self%nh1%L
+      block
+        type(empm_mms_neohookean_1d_t) :: m
+        self%uscale = m%A; self%vscale = m%A * pi * sqrt(m%E / m%rho0) / m%L
+        self%sscale = m%E * m%A * 2.0_wp * pi / m%L
+        allocate(self%mms, source=m)
+      end block
     case ('mms_axis_aligned_2d')
-      call set_initial_state(cs)
-      allocate(cs%model%loads%body_force, source=self%aa2)
-      self%uscale = self%aa2%A; self%vscale = self%aa2%A * pi * sqrt(self%aa2%E / self%aa2%rho0)
-      self%sscale = self%aa2%E * self%aa2%A * 2.0_wp * pi / self%aa2%L
+      block
+        type(empm_mms_axis_aligned_2d_t) :: m
+        self%uscale = m%A; self%vscale = m%A * pi * sqrt(m%E / m%rho0)
+        self%sscale = m%E * m%A * 2.0_wp * pi / m%L
+        allocate(self%mms, source=m)
+      end block
     case ('colliding_disks')
     case default
       emsg = 'unknown benchmark '''//trim(id)//'''; known: '//KNOWN
     end select
+    if (allocated(self%mms) .and. len(emsg) == 0) then
+      call set_initial_state(cs)
+      allocate(cs%model%loads%body_force, source=self%mms)
+    end if
 
   contains
 
@@ -169,19 +173,11 @@ contains
     ! Particles start on the manufactured solution: x = X + u(X,0), v, F, stress, density.
     subroutine set_initial_state(cs)
       type(empm_case_t), intent(inout) :: cs
-      real(wp) :: u(3), v(3), s(6), F(3, 3), J
+      real(wp) :: u(3), v(3), s(6), F(3, 3), J, b(3)
       integer :: q, d
       d = cs%model%grid%ndim
       do q = 1, cs%model%pts%np
-        associate (X => cs%model%pts%x0(:, q))
-          call self%exact(X, 0.0_wp, u(1:d), v(1:d), s)
-          select case (trim(self%id))
-          case ('mms_linear_1d'); F = self%ml1%def_grad(X, 0.0_wp)
-          case ('mms_linear_2d'); F = self%ml2%def_grad(X, 0.0_wp)
-          case ('mms_neohookean_1d'); F = self%nh1%def_grad(X, 0.0_wp)
-          case default; F = self%aa2%def_grad(X, 0.0_wp)
-          end select
-        end associate
+        call self%mms%fields(cs%model%pts%x0(:, q), 0.0_wp, u(1:d), v(1:d), F, s, b(1:d))
         J = det3(F)
         cs%model%pts%x(:, q) = cs%model%pts%x0(:, q) + u(1:d)
         cs%model%pts%v(:, q) = v(1:d)
