@@ -68,6 +68,13 @@ contains
     !$omp end parallel do
   end subroutine p2g_work_set_ranges
 
+  !> True when a P2G call runs on per-thread chunks (a workspace with more than one chunk).
+  pure logical function threaded(ws)
+    type(empm_p2g_work_t), intent(in), optional :: ws
+    threaded = .false.
+    if (present(ws)) threaded = ws%nt > 1
+  end function threaded
+
   !> Particles p0..p1 of chunk c (0-based) of n chunks over np particles.
   pure subroutine chunk_bounds(np, n, c, p0, p1)
     integer, intent(in) :: np, n, c
@@ -132,9 +139,7 @@ contains
     real(wp), intent(inout) :: mass(:)                       !! nodal masses (accumulated)
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
     integer :: c, p0, p1
-    if (.not. present(ws)) then
-      call mass_range(basis, m, 1, basis%np, mass); return
-    else if (ws%nt <= 1) then
+    if (.not. threaded(ws)) then
       call mass_range(basis, m, 1, basis%np, mass); return
     end if
     !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
@@ -176,9 +181,7 @@ contains
     real(wp), intent(inout) :: q(:,:)                        !! nodal vectors (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
     integer :: ic, p0, p1
-    if (.not. present(ws)) then
-      call weighted_range(basis, m, u, c, w, 1, basis%np, q); return
-    else if (ws%nt <= 1) then
+    if (.not. threaded(ws)) then
       call weighted_range(basis, m, u, c, w, 1, basis%np, q); return
     end if
     !$omp parallel num_threads(ws%nt) default(shared) private(ic, p0, p1)
@@ -224,9 +227,7 @@ contains
     real(wp), intent(inout) :: f(:,:)                        !! nodal forces (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
     integer :: c, p0, p1
-    if (.not. present(ws)) then
-      call internal_range(basis, vol, stress, 1, basis%np, f); return
-    else if (ws%nt <= 1) then
+    if (.not. threaded(ws)) then
       call internal_range(basis, vol, stress, 1, basis%np, f); return
     end if
     !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
@@ -284,9 +285,7 @@ contains
     integer :: c, p0, p1
     ! Nothing to add: skip the pass (adding zeros leaves f unchanged bit for bit).
     if (.not. use_b .and. all(g == 0.0_wp)) return
-    if (.not. present(ws)) then
-      call body_range(basis, m, g, b, use_b, 1, basis%np, f); return
-    else if (ws%nt <= 1) then
+    if (.not. threaded(ws)) then
       call body_range(basis, m, g, b, use_b, 1, basis%np, f); return
     end if
     !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
