@@ -16,18 +16,9 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from scheme_style import STYLE  # noqa: E402  (same folder as this script)
+
 HERE = os.path.dirname(os.path.abspath(__file__))
-STYLE = {
-    "usf": ("tab:blue", "-"),
-    "usl": ("tab:orange", "-"),
-    "musl": ("tab:green", ":"),
-    "pc_published": ("tab:red", "-"),
-    "pc_newmark": ("black", "--"),
-    "gen_alpha_rb0.0": ("tab:purple", "-"),
-    "gen_alpha_rb0.5": ("tab:brown", "-"),
-    "gen_alpha_rb0.8": ("tab:pink", "-"),
-    "gen_alpha_rb1.0": ("tab:olive", "-"),
-}
 ROWS = [
     ("vibrating_bar", "vibrating bar, h = 1, CFL 0.5", 10.0, "t / T"),
     ("colliding_disks_cfl0.1", "colliding disks, CFL 0.1", 1.0, "t [s]"),
