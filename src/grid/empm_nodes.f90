@@ -45,14 +45,10 @@ contains
   !> Zero every nodal field (step 9 of the paper's algorithm); constraints are kept.
   subroutine nodes_reset(self)
     class(empm_nodes_t), intent(inout) :: self !! nodal fields
-    integer :: I
-    ! Threaded over nodes on large grids (the only grid-sized pass of every step).
-    !$omp parallel do schedule(static) if(self%nnode >= 4096)
-    do I = 1, self%nnode
-      self%mass(I) = 0.0_wp; self%mom(:, I) = 0.0_wp; self%vel(:, I) = 0.0_wp
-      self%force(:, I) = 0.0_wp; self%acc(:, I) = 0.0_wp
-    end do
-    !$omp end parallel do
+    ! Whole-array assignments: one contiguous fill per field (per-node slices of run-time
+    ! length cost a library call each).
+    self%mass = 0.0_wp; self%mom = 0.0_wp; self%vel = 0.0_wp
+    self%force = 0.0_wp; self%acc = 0.0_wp
   end subroutine nodes_reset
 
   !> Constrain components `comp` of every node inside the closed box [lo, hi] (a node set by

@@ -12,7 +12,7 @@ module empm_integrator_euler
   use empm_kinds, only: wp
   use empm_integrator, only: empm_integrator_t, eval_basis, update_stress
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
-  use empm_transfer, only: p2g_mass, p2g_weighted, g2p_add_scaled, g2p_value, &
+  use empm_transfer, only: p2g_mass_momentum, p2g_weighted, g2p_add_scaled, g2p_value, &
                            velocity_gradient, nodal_divide_by_mass, constrain_velocity
   use empm_timer, only: PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
@@ -56,8 +56,8 @@ contains
       call tm%lap(PHASE_SHAPE)
       if (stat%code /= STEP_OK) return
       call nodes%reset()
-      call p2g_mass(basis, pts%m, nodes%mass, self%p2g)
-      call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom, self%p2g)
+      call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
+                             self%p2g)
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
       call constrain_velocity(nodes, nodes%vel, nodes%mom)

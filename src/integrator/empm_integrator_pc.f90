@@ -15,7 +15,7 @@ module empm_integrator_pc
   use empm_kinds, only: wp
   use empm_integrator, only: empm_integrator_t, eval_basis, update_stress, initial_acceleration
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
-  use empm_transfer, only: p2g_mass, p2g_weighted, g2p_add_scaled, g2p_value, g2p_pc_newmark, &
+  use empm_transfer, only: p2g_mass_momentum, g2p_add_scaled, g2p_value, g2p_pc_newmark, &
                            velocity_gradient, nodal_divide_by_mass, constrain_velocity
   use empm_timer, only: PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
@@ -69,9 +69,10 @@ contains
       call tm%lap(PHASE_SHAPE)
       if (stat%code /= STEP_OK) return
       call nodes%reset()
-      call p2g_mass(basis, pts%m, nodes%mass, self%p2g)
-      ! Predictor, formed from particle data (eq. 31) to avoid dividing accelerations.
-      call p2g_weighted(basis, pts%m, pts%v, (1.0_wp - g) * dt, pts%a, nodes%mom, self%p2g)
+      ! Mass and predictor in one pass, the predictor formed from particle data (eq. 31) to
+      ! avoid dividing accelerations.
+      call p2g_mass_momentum(basis, pts%m, pts%v, (1.0_wp - g) * dt, pts%a, nodes%mass, &
+                             nodes%mom, self%p2g)
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
       call constrain_velocity(nodes, nodes%vel, nodes%mom)

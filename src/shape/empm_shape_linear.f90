@@ -81,6 +81,11 @@ contains
     associate (unused_ => self); end associate
     call shape_batch_fits(pts%np, basis, ibad, info)
     if (info /= SHAPE_OK) return
+    if (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4) then
+      call linear_batch_2d(grid, pts%np, pts%x, basis%maxn, basis%nn, basis%node, basis%N, &
+                           basis%dN, ibad, info)
+      return
+    end if
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
     !$omp parallel do schedule(static) private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
@@ -166,6 +171,61 @@ contains
     dN(1, 3) = -h1 * t2; dN(2, 3) = u1 * h2
     dN(1, 4) = h1 * t2;  dN(2, 4) = t1 * h2
   end subroutine linear_2d
+
+  !> Bilinear values and gradients at particles 1..np (the 2D batch of [[linear_eval_batch]]):
+  !> the expressions of [[linear_2d]] on explicit-shape arrays, with the grid-box test inline.
+  subroutine linear_batch_2d(grid, np, x, mx, nn, node, N, dN, ibad, info)
+    type(empm_grid_t), intent(in) :: grid    !! background grid (2D)
+    integer, intent(in) :: np                !! number of particles
+    real(wp), intent(in) :: x(2, *)          !! particle positions
+    integer, intent(in) :: mx                !! basis capacity (>= 4)
+    integer, intent(inout) :: nn(*)          !! nodes per particle
+    integer, intent(inout) :: node(mx, *)    !! node indices
+    real(wp), intent(inout) :: N(mx, *)      !! values
+    real(wp), intent(inout) :: dN(2, mx, *)  !! gradients
+    integer, intent(out) :: ibad             !! first particle outside the grid, 0 if none
+    integer, intent(out) :: info             !! SHAPE_OK or SHAPE_OUTSIDE_GRID
+    real(wp) :: o1, o2, e1, e2, h1, h2, s1, s2, t1, t2, u1, u2
+    integer :: p, i0, j0, id, n1, c1, c2
+    o1 = grid%origin(1); o2 = grid%origin(2)
+    e1 = grid%origin(1) + grid%ncell(1) * grid%h(1)
+    e2 = grid%origin(2) + grid%ncell(2) * grid%h(2)
+    h1 = grid%inv_h(1); h2 = grid%inv_h(2)
+    n1 = grid%nn(1); c1 = grid%ncell(1) - 1; c2 = grid%ncell(2) - 1
+    ibad = huge(1)
+    info = SHAPE_OK
+    !$omp parallel do schedule(static) private(i0, j0, id, s1, s2, t1, t2, u1, u2) &
+    !$omp   reduction(min: ibad) if(np >= EMPM_OMP_MIN_PARTICLES)
+    do p = 1, np
+      ! The test of grid%inside, as there (a NaN coordinate fails it).
+      if (.not. (x(1, p) >= o1 .and. x(1, p) <= e1 .and. x(2, p) >= o2 .and. &
+                 x(2, p) <= e2)) then
+        nn(p) = 0
+        ibad = min(ibad, p)
+        cycle
+      end if
+      s1 = (x(1, p) - o1) * h1
+      s2 = (x(2, p) - o2) * h2
+      i0 = min(max(floor(s1), 0), c1)
+      j0 = min(max(floor(s2), 0), c2)
+      t1 = min(max(s1 - i0, 0.0_wp), 1.0_wp); u1 = 1.0_wp - t1
+      t2 = min(max(s2 - j0, 0.0_wp), 1.0_wp); u2 = 1.0_wp - t2
+      id = 1 + i0 + n1 * j0
+      nn(p) = 4
+      node(1, p) = id; node(2, p) = id + 1; node(3, p) = id + n1; node(4, p) = id + n1 + 1
+      N(1, p) = u1 * u2; N(2, p) = t1 * u2; N(3, p) = u1 * t2; N(4, p) = t1 * t2
+      dN(1, 1, p) = -h1 * u2; dN(2, 1, p) = -u1 * h2
+      dN(1, 2, p) = h1 * u2;  dN(2, 2, p) = -t1 * h2
+      dN(1, 3, p) = -h1 * t2; dN(2, 3, p) = u1 * h2
+      dN(1, 4, p) = h1 * t2;  dN(2, 4, p) = t1 * h2
+    end do
+    !$omp end parallel do
+    if (ibad == huge(1)) then
+      ibad = 0
+    else
+      info = SHAPE_OUTSIDE_GRID
+    end if
+  end subroutine linear_batch_2d
 
   !> Reset tensor-product factors to the neutral values used along directions beyond ndim:
   !> one node at index 0 with value 1 and derivative 0.

@@ -9,23 +9,30 @@
 !> chunk order, over the node range each chunk touched. Sums are therefore fixed for a given
 !> thread count (reproducible run to run) and equal to the serial sums to round-off; with one
 !> thread, or without a workspace, they are the serial sums bit for bit.
+!>
+!> Every kernel dispatches on the dimension once per particle chunk: 2D runs use the
+!> specialised loops of [[empm_transfer_2d]] (same arithmetic, same order, same bits), other
+!> dimensions the generic loops here. Nodal and particle arrays must be contiguous.
 module empm_transfer
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   use empm_shape, only: empm_basis_t
   use empm_nodes, only: empm_nodes_t
-  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
+  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_max_threads
+  use empm_transfer_2d, only: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, &
+                              g2p_value_2d, g2p_add_scaled_2d, g2p_pc_newmark_2d
   implicit none
   private
   public :: empm_p2g_work_t
-  public :: p2g_mass, p2g_weighted, p2g_internal_force, p2g_body_force
+  public :: p2g_mass, p2g_weighted, p2g_mass_momentum, p2g_internal_force, p2g_body_force
   public :: g2p_value, g2p_add_scaled, g2p_pc_newmark, velocity_gradient
   public :: nodal_divide_by_mass, constrain_velocity, constrain_force
 
   !> Per-thread nodal accumulators of a race-free P2G; kept zero between calls.
   type :: empm_p2g_work_t
     integer :: nt = 1                       !! particle chunks (threads); 1 = serial
-    real(wp), allocatable :: buf(:,:,:)     !! accumulators of chunks 2..nt (ndim, nnode, nt-1)
+    real(wp), allocatable :: buf(:,:,:)     !! vector accumulators of chunks 2..nt (ndim, nnode, nt-1)
+    real(wp), allocatable :: mbuf(:,:)      !! scalar (mass) accumulators of chunks 2..nt (nnode, nt-1)
     integer, allocatable :: lo(:)           !! first node touched by each chunk (nt); set by
                                             !! set_ranges after every basis evaluation
     integer, allocatable :: hi(:)           !! last node touched by each chunk (nt)
@@ -46,9 +53,10 @@ contains
     integer, intent(in) :: nthreads               !! threads to use
     self%nt = max(1, nthreads)
     if (np < EMPM_OMP_MIN_PARTICLES) self%nt = 1
-    if (allocated(self%buf)) deallocate(self%buf, self%lo, self%hi)
-    allocate(self%buf(ndim, nnode, self%nt - 1), self%lo(self%nt), self%hi(self%nt))
-    self%buf = 0.0_wp
+    if (allocated(self%buf)) deallocate(self%buf, self%mbuf, self%lo, self%hi)
+    allocate(self%buf(ndim, nnode, self%nt - 1), self%mbuf(nnode, self%nt - 1), &
+             self%lo(self%nt), self%hi(self%nt))
+    self%buf = 0.0_wp; self%mbuf = 0.0_wp
     self%lo = 1; self%hi = 0
   end subroutine p2g_work_init
 
@@ -115,7 +123,7 @@ contains
     !$omp end do
   end subroutine reduce_vec
 
-  !> As [[reduce_vec]] for a scalar nodal field (first buffer component).
+  !> As [[reduce_vec]] for a scalar nodal field (the scalar buffers).
   subroutine reduce_scalar(ws, q)
     type(empm_p2g_work_t), intent(inout) :: ws
     real(wp), intent(inout) :: q(:)
@@ -125,8 +133,8 @@ contains
     do I = ilo, ihi
       do c = 2, ws%nt
         if (I < ws%lo(c) .or. I > ws%hi(c)) cycle
-        q(I) = q(I) + ws%buf(1, I, c - 1)
-        ws%buf(1, I, c - 1) = 0.0_wp
+        q(I) = q(I) + ws%mbuf(I, c - 1)
+        ws%mbuf(I, c - 1) = 0.0_wp
       end do
     end do
     !$omp end do
@@ -149,7 +157,7 @@ contains
       if (c == 1) then
         call mass_range(basis, m, p0, p1, mass)
       else
-        call mass_range(basis, m, p0, p1, ws%buf(1, :, c - 1))
+        call mass_range(basis, m, p0, p1, ws%mbuf(:, c - 1))
       end if
     end do
     !$omp end do
@@ -204,27 +212,76 @@ contains
     real(wp), intent(in) :: m(:), u(:,:), c, w(:,:)
     integer, intent(in) :: p0, p1
     real(wp), intent(inout) :: q(:,:)
-    real(wp) :: mu(size(u, 1))
-    integer :: p, k, I
+    real(wp) :: mu(3)
+    integer :: p, k, I, d
+    d = size(u, 1)
     do p = p0, p1
       if (c == 0.0_wp) then
-        mu = m(p) * u(:, p)
+        mu(1:d) = m(p) * u(:, p)
       else
-        mu = m(p) * (u(:, p) + c * w(:, p))
+        mu(1:d) = m(p) * (u(:, p) + c * w(:, p))
       end if
       do k = 1, basis%nn(p)
         I = basis%node(k, p)
-        q(:, I) = q(:, I) + basis%N(k, p) * mu
+        q(:, I) = q(:, I) + basis%N(k, p) * mu(1:d)
       end do
     end do
   end subroutine weighted_range
+
+  !> Lumped mass and a mass-weighted vector in one pass over the particles:
+  !> m_I += Σ_p N_Ip m_p and q_I += Σ_p N_Ip m_p (u_p + c·w_p). The same sums as
+  !> [[p2g_mass]] followed by [[p2g_weighted]], bit for bit, reading the basis once.
+  subroutine p2g_mass_momentum(basis, m, u, c, w, mass, q, ws)
+    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                             !! particle masses
+    real(wp), intent(in), contiguous :: u(:,:)               !! particle vectors (ndim, np)
+    real(wp), intent(in) :: c                                !! scale of the second vector (0 to ignore it)
+    real(wp), intent(in), contiguous :: w(:,:)               !! second particle vectors (ndim, np)
+    real(wp), intent(inout), contiguous :: mass(:)           !! nodal masses (accumulated)
+    real(wp), intent(inout), contiguous :: q(:,:)            !! nodal vectors (ndim, nnode), accumulated
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
+    integer :: ic, p0, p1
+    if (.not. threaded(ws)) then
+      call mass_momentum_range(basis, m, u, c, w, 1, basis%np, mass, q); return
+    end if
+    !$omp parallel num_threads(ws%nt) default(shared) private(ic, p0, p1)
+    !$omp do schedule(static, 1)
+    do ic = 1, ws%nt
+      call chunk_bounds(basis%np, ws%nt, ic - 1, p0, p1)
+      if (ic == 1) then
+        call mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q)
+      else
+        call mass_momentum_range(basis, m, u, c, w, p0, p1, ws%mbuf(:, ic - 1), &
+                                 ws%buf(:, :, ic - 1))
+      end if
+    end do
+    !$omp end do
+    call reduce_scalar(ws, mass)
+    call reduce_vec(ws, q)
+    !$omp end parallel
+  end subroutine p2g_mass_momentum
+
+  pure subroutine mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q)
+    type(empm_basis_t), intent(in) :: basis
+    real(wp), intent(in) :: m(:), c
+    real(wp), intent(in), contiguous :: u(:,:), w(:,:)
+    integer, intent(in) :: p0, p1
+    real(wp), intent(inout), contiguous :: mass(:), q(:,:)
+    if (basis%ndim == 2) then
+      call mass_momentum_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, m, u, c, w, &
+                            mass, q)
+    else
+      call mass_range(basis, m, p0, p1, mass)
+      call weighted_range(basis, m, u, c, w, p0, p1, q)
+    end if
+  end subroutine mass_momentum_range
 
   !> Internal force f_I −= Σ_p V_p σ_p ∇N_Ip (paper eq. 16), σ in Voigt order.
   subroutine p2g_internal_force(basis, vol, stress, f, ws)
     type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
     real(wp), intent(in) :: vol(:)                           !! particle volumes
-    real(wp), intent(in) :: stress(:,:)                      !! Cauchy stress (6, np)
-    real(wp), intent(inout) :: f(:,:)                        !! nodal forces (ndim, nnode), accumulated
+    real(wp), intent(in), contiguous :: stress(:,:)          !! Cauchy stress (6, np)
+    real(wp), intent(inout), contiguous :: f(:,:)            !! nodal forces (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
     integer :: c, p0, p1
     if (.not. threaded(ws)) then
@@ -247,12 +304,17 @@ contains
 
   pure subroutine internal_range(basis, vol, stress, p0, p1, f)
     type(empm_basis_t), intent(in) :: basis
-    real(wp), intent(in) :: vol(:), stress(:,:)
+    real(wp), intent(in) :: vol(:)
+    real(wp), intent(in), contiguous :: stress(:,:)
     integer, intent(in) :: p0, p1
-    real(wp), intent(inout) :: f(:,:)
+    real(wp), intent(inout), contiguous :: f(:,:)
     real(wp) :: s(3, 3), t
     integer :: p, k, I, d, a, b
     d = basis%ndim
+    if (d == 2) then
+      call internal_force_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%dN, vol, stress, f)
+      return
+    end if
     do p = p0, p1
       s(1, 1) = stress(1, p); s(2, 2) = stress(2, p); s(3, 3) = stress(3, p)
       s(2, 3) = stress(4, p); s(3, 2) = stress(4, p)
@@ -309,30 +371,46 @@ contains
     logical, intent(in) :: use_b
     integer, intent(in) :: p0, p1
     real(wp), intent(inout) :: f(:,:)
-    real(wp) :: fp(size(g))
-    integer :: p, k, I
+    real(wp) :: fp(3)
+    integer :: p, k, I, d
+    d = size(g)
     do p = p0, p1
-      fp = g
-      if (use_b) fp = fp + b(:, p)
-      fp = m(p) * fp
+      fp(1:d) = g
+      if (use_b) fp(1:d) = fp(1:d) + b(:, p)
+      fp(1:d) = m(p) * fp(1:d)
       do k = 1, basis%nn(p)
         I = basis%node(k, p)
-        f(:, I) = f(:, I) + basis%N(k, p) * fp
+        f(:, I) = f(:, I) + basis%N(k, p) * fp(1:d)
       end do
     end do
   end subroutine body_range
 
+  !> Particle chunks of a G2P pass: one per thread on large batches, else one.
+  integer function g2p_chunks(np) result(nc)
+    integer, intent(in) :: np
+    nc = 1
+    if (np >= EMPM_OMP_MIN_PARTICLES) nc = empm_max_threads()
+  end function g2p_chunks
+
   !> Interpolate a nodal vector to the particles: u_p = Σ_I N_Ip q_I.
   subroutine g2p_value(basis, q, u)
-    type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
-    real(wp), intent(in) :: q(:,:)          !! nodal vectors (ndim, nnode)
-    real(wp), intent(out) :: u(:,:)         !! particle vectors (ndim, np)
-    integer :: p, k
-    !$omp parallel do schedule(static) private(k) if(basis%np >= EMPM_OMP_MIN_PARTICLES)
-    do p = 1, basis%np
-      u(:, p) = 0.0_wp
-      do k = 1, basis%nn(p)
-        u(:, p) = u(:, p) + basis%N(k, p) * q(:, basis%node(k, p))
+    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
+    real(wp), intent(in), contiguous :: q(:,:)       !! nodal vectors (ndim, nnode)
+    real(wp), intent(out), contiguous :: u(:,:)      !! particle vectors (ndim, np)
+    integer :: c, nc, p0, p1, p, k
+    nc = g2p_chunks(basis%np)
+    !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k) if(nc > 1)
+    do c = 0, nc - 1
+      call chunk_bounds(basis%np, nc, c, p0, p1)
+      if (basis%ndim == 2) then
+        call g2p_value_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, u)
+        cycle
+      end if
+      do p = p0, p1
+        u(:, p) = 0.0_wp
+        do k = 1, basis%nn(p)
+          u(:, p) = u(:, p) + basis%N(k, p) * q(:, basis%node(k, p))
+        end do
       end do
     end do
     !$omp end parallel do
@@ -340,19 +418,28 @@ contains
 
   !> Add a scaled interpolated nodal vector: u_p += c Σ_I N_Ip q_I.
   subroutine g2p_add_scaled(basis, c, q, u)
-    type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
-    real(wp), intent(in) :: c               !! scale (e.g. Δt)
-    real(wp), intent(in) :: q(:,:)          !! nodal vectors (ndim, nnode)
-    real(wp), intent(inout) :: u(:,:)       !! particle vectors (ndim, np)
-    real(wp) :: s(size(u, 1))
-    integer :: p, k
-    !$omp parallel do schedule(static) private(k, s) if(basis%np >= EMPM_OMP_MIN_PARTICLES)
-    do p = 1, basis%np
-      s = 0.0_wp
-      do k = 1, basis%nn(p)
-        s = s + basis%N(k, p) * q(:, basis%node(k, p))
+    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
+    real(wp), intent(in) :: c                        !! scale (e.g. Δt)
+    real(wp), intent(in), contiguous :: q(:,:)       !! nodal vectors (ndim, nnode)
+    real(wp), intent(inout), contiguous :: u(:,:)    !! particle vectors (ndim, np)
+    real(wp) :: s(3)
+    integer :: ic, nc, p0, p1, p, k, d
+    d = basis%ndim
+    nc = g2p_chunks(basis%np)
+    !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, s) if(nc > 1)
+    do ic = 0, nc - 1
+      call chunk_bounds(basis%np, nc, ic, p0, p1)
+      if (d == 2) then
+        call g2p_add_scaled_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, c, q, u)
+        cycle
+      end if
+      do p = p0, p1
+        s(1:d) = 0.0_wp
+        do k = 1, basis%nn(p)
+          s(1:d) = s(1:d) + basis%N(k, p) * q(:, basis%node(k, p))
+        end do
+        u(:, p) = u(:, p) + c * s(1:d)
       end do
-      u(:, p) = u(:, p) + c * s
     end do
     !$omp end parallel do
   end subroutine g2p_add_scaled
@@ -361,55 +448,75 @@ contains
   !> particles (the same arithmetic as the separate G2P calls, in the same order):
   !> x += Δt Σ N v*_I + (γ − ½)Δt² a;  v += (1−γ)Δt a;  a = Σ N a_I;  v += γΔt a.
   subroutine g2p_pc_newmark(basis, dt, g, vel, acc, x, v, a)
-    type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
-    real(wp), intent(in) :: dt              !! time step [s]
-    real(wp), intent(in) :: g               !! Newmark γ
-    real(wp), intent(in) :: vel(:,:)        !! predicted nodal velocities v*_I (ndim, nnode)
-    real(wp), intent(in) :: acc(:,:)        !! nodal accelerations a_I (ndim, nnode)
-    real(wp), intent(inout) :: x(:,:)       !! particle positions (ndim, np)
-    real(wp), intent(inout) :: v(:,:)       !! particle velocities (ndim, np)
-    real(wp), intent(inout) :: a(:,:)       !! particle accelerations (ndim, np): a^n in, a^{n+1} out
-    real(wp) :: sv(size(x, 1)), sa(size(x, 1))
-    integer :: p, k, I
-    !$omp parallel do schedule(static) private(k, I, sv, sa) if(basis%np >= EMPM_OMP_MIN_PARTICLES)
-    do p = 1, basis%np
-      sv = 0.0_wp; sa = 0.0_wp
-      do k = 1, basis%nn(p)
-        I = basis%node(k, p)
-        sv = sv + basis%N(k, p) * vel(:, I)
-        sa = sa + basis%N(k, p) * acc(:, I)
+    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
+    real(wp), intent(in) :: dt                       !! time step [s]
+    real(wp), intent(in) :: g                        !! Newmark γ
+    real(wp), intent(in), contiguous :: vel(:,:)     !! predicted nodal velocities v*_I (ndim, nnode)
+    real(wp), intent(in), contiguous :: acc(:,:)     !! nodal accelerations a_I (ndim, nnode)
+    real(wp), intent(inout), contiguous :: x(:,:)    !! particle positions (ndim, np)
+    real(wp), intent(inout), contiguous :: v(:,:)    !! particle velocities (ndim, np)
+    real(wp), intent(inout), contiguous :: a(:,:)    !! particle accelerations (ndim, np): a^n in,
+                                                     !! a^{n+1} out
+    real(wp) :: sv(3), sa(3)
+    integer :: c, nc, p0, p1, p, k, I, d
+    d = basis%ndim
+    nc = g2p_chunks(basis%np)
+    !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, I, sv, sa) if(nc > 1)
+    do c = 0, nc - 1
+      call chunk_bounds(basis%np, nc, c, p0, p1)
+      if (d == 2) then
+        call g2p_pc_newmark_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, dt, g, &
+                               vel, acc, x, v, a)
+        cycle
+      end if
+      do p = p0, p1
+        sv(1:d) = 0.0_wp; sa(1:d) = 0.0_wp
+        do k = 1, basis%nn(p)
+          I = basis%node(k, p)
+          sv(1:d) = sv(1:d) + basis%N(k, p) * vel(:, I)
+          sa(1:d) = sa(1:d) + basis%N(k, p) * acc(:, I)
+        end do
+        x(:, p) = x(:, p) + dt * sv(1:d)
+        x(:, p) = x(:, p) + (g - 0.5_wp) * dt * dt * a(:, p)
+        v(:, p) = v(:, p) + (1.0_wp - g) * dt * a(:, p)
+        a(:, p) = sa(1:d)
+        v(:, p) = v(:, p) + g * dt * a(:, p)
       end do
-      x(:, p) = x(:, p) + dt * sv
-      x(:, p) = x(:, p) + (g - 0.5_wp) * dt * dt * a(:, p)
-      v(:, p) = v(:, p) + (1.0_wp - g) * dt * a(:, p)
-      a(:, p) = sa
-      v(:, p) = v(:, p) + g * dt * a(:, p)
     end do
     !$omp end parallel do
   end subroutine g2p_pc_newmark
 
   !> Velocity gradient L_p = Σ_I v_I ⊗ ∇N_Ip, embedded in 3×3 (zeros in unused directions).
   subroutine velocity_gradient(basis, v, L)
-    type(empm_basis_t), intent(in) :: basis !! shape functions at the particles
-    real(wp), intent(in) :: v(:,:)          !! nodal velocities (ndim, nnode)
-    real(wp), intent(inout) :: L(:,:,:)     !! velocity gradients (3, 3, np); only the ndim×ndim
-                                            !! block is written (the rest stays 0 from set-up)
+    type(empm_basis_t), intent(in) :: basis           !! shape functions at the particles
+    real(wp), intent(in), contiguous :: v(:,:)        !! nodal velocities (ndim, nnode)
+    real(wp), intent(inout), contiguous :: L(:,:,:)   !! velocity gradients (3, 3, np); only the
+                                                      !! ndim×ndim block is written (the rest
+                                                      !! stays 0 from set-up)
     real(wp) :: g(3, 3)
-    integer :: p, k, I, a, b, d
+    integer :: c, nc, p0, p1, p, k, I, a, b, d
     d = basis%ndim
-    !$omp parallel do schedule(static) private(k, I, a, b, g) if(basis%np >= EMPM_OMP_MIN_PARTICLES)
-    do p = 1, basis%np
-      ! Accumulate in registers, store once: fewer writes to the particle array.
-      g = 0.0_wp
-      do k = 1, basis%nn(p)
-        I = basis%node(k, p)
-        do b = 1, d
-          do a = 1, d
-            g(a, b) = g(a, b) + v(a, I) * basis%dN(b, k, p)
+    nc = g2p_chunks(basis%np)
+    !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, I, a, b, g) if(nc > 1)
+    do c = 0, nc - 1
+      call chunk_bounds(basis%np, nc, c, p0, p1)
+      if (d == 2) then
+        call velocity_gradient_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%dN, v, L)
+        cycle
+      end if
+      do p = p0, p1
+        ! Accumulate in registers, store once: fewer writes to the particle array.
+        g = 0.0_wp
+        do k = 1, basis%nn(p)
+          I = basis%node(k, p)
+          do b = 1, d
+            do a = 1, d
+              g(a, b) = g(a, b) + v(a, I) * basis%dN(b, k, p)
+            end do
           end do
         end do
+        L(1:d, 1:d, p) = g(1:d, 1:d)
       end do
-      L(1:d, 1:d, p) = g(1:d, 1:d)
     end do
     !$omp end parallel do
   end subroutine velocity_gradient
@@ -419,13 +526,17 @@ contains
     type(empm_nodes_t), intent(in) :: nodes !! nodal fields (mass, mass_tol)
     real(wp), intent(in) :: q(:,:)          !! nodal vectors (ndim, nnode)
     real(wp), intent(out) :: out(:,:)       !! q/m (ndim, nnode)
-    integer :: I
-    !$omp parallel do schedule(static) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
+    integer :: I, d
+    !$omp parallel do schedule(static) private(d) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
     do I = 1, nodes%nnode
       if (nodes%mass(I) > nodes%mass_tol) then
-        out(:, I) = q(:, I) / nodes%mass(I)
+        do d = 1, nodes%ndim
+          out(d, I) = q(d, I) / nodes%mass(I)
+        end do
       else
-        out(:, I) = 0.0_wp
+        do d = 1, nodes%ndim
+          out(d, I) = 0.0_wp
+        end do
       end if
     end do
     !$omp end parallel do
@@ -436,13 +547,16 @@ contains
     type(empm_nodes_t), intent(in) :: nodes   !! nodal constraints and masses
     real(wp), intent(inout) :: v(:,:)         !! nodal velocities (ndim, nnode)
     real(wp), intent(inout) :: mom(:,:)       !! nodal momenta (ndim, nnode)
-    integer :: I
-    !$omp parallel do schedule(static) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
+    integer :: I, d
+    ! Explicit loops: a masked assignment here allocates a mask temporary per node.
+    !$omp parallel do schedule(static) private(d) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
     do I = 1, nodes%nnode
-      where (nodes%fixed(:, I))
-        v(:, I) = nodes%vfix(:, I)
-        mom(:, I) = nodes%mass(I) * nodes%vfix(:, I)
-      end where
+      do d = 1, nodes%ndim
+        if (nodes%fixed(d, I)) then
+          v(d, I) = nodes%vfix(d, I)
+          mom(d, I) = nodes%mass(I) * nodes%vfix(d, I)
+        end if
+      end do
     end do
     !$omp end parallel do
   end subroutine constrain_velocity
@@ -451,10 +565,12 @@ contains
   subroutine constrain_force(nodes, f)
     type(empm_nodes_t), intent(in) :: nodes !! nodal constraints
     real(wp), intent(inout) :: f(:,:)       !! nodal forces (ndim, nnode)
-    integer :: I
-    !$omp parallel do schedule(static) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
+    integer :: I, d
+    !$omp parallel do schedule(static) private(d) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
     do I = 1, nodes%nnode
-      where (nodes%fixed(:, I)) f(:, I) = 0.0_wp
+      do d = 1, nodes%ndim
+        if (nodes%fixed(d, I)) f(d, I) = 0.0_wp
+      end do
     end do
     !$omp end parallel do
   end subroutine constrain_force

@@ -1,0 +1,173 @@
+!> Two-dimensional transfer kernels: the hot particle loops of [[empm_transfer]] with the
+!> dimension fixed at compile time.
+!>
+!> Plane-strain runs are the common case, and the generic kernels spend most of their
+!> instructions on run-time-sized inner loops (and on zeroing small temporaries); here the
+!> nodal and particle vectors are scalars in registers. Each kernel does the same arithmetic in
+!> the same order as its generic counterpart, so results are identical bit for bit. The
+!> (x, y) pairs are written as two-element array operations so that the compiler can keep each
+!> pair in one SIMD register. Arrays are
+!> explicit-shape (leading extents known) and contiguous; the caller passes the basis arrays of
+!> an [[empm_basis_t]] with `mx = basis%maxn` and a particle range p0..p1.
+module empm_transfer_2d
+  use empm_kinds, only: wp
+  implicit none
+  private
+  public :: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, g2p_value_2d, &
+            g2p_add_scaled_2d, g2p_pc_newmark_2d
+
+contains
+
+  !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (c = 0 ignores w).
+  pure subroutine mass_momentum_2d(mx, p0, p1, nn, node, N, m, u, c, w, mass, q)
+    integer, intent(in) :: mx                !! basis capacity (nodes per particle)
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: N(mx, *)         !! shape-function values
+    real(wp), intent(in) :: m(*)             !! particle masses
+    real(wp), intent(in) :: u(2, *)          !! particle vectors
+    real(wp), intent(in) :: c                !! scale of `w`
+    real(wp), intent(in) :: w(2, *)          !! second particle vectors
+    real(wp), intent(inout) :: mass(*)       !! nodal masses (accumulated)
+    real(wp), intent(inout) :: q(2, *)       !! nodal vectors (accumulated)
+    real(wp) :: mu(2), nk
+    integer :: p, k, I
+    ! Two-component vector operations throughout: the compiler packs them into SIMD pairs.
+    do p = p0, p1
+      if (c == 0.0_wp) then
+        mu = m(p) * u(:, p)
+      else
+        mu = m(p) * (u(:, p) + c * w(:, p))
+      end if
+      do k = 1, nn(p)
+        I = node(k, p); nk = N(k, p)
+        mass(I) = mass(I) + nk * m(p)
+        q(:, I) = q(:, I) + nk * mu
+      end do
+    end do
+  end subroutine mass_momentum_2d
+
+  !> f_I −= Σ V_p σ_p ∇N_Ip (σ in Voigt order: xx, yy, zz, yz, xz, xy).
+  pure subroutine internal_force_2d(mx, p0, p1, nn, node, dN, vol, stress, f)
+    integer, intent(in) :: mx                !! basis capacity
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: dN(2, mx, *)     !! shape-function gradients
+    real(wp), intent(in) :: vol(*)           !! particle volumes
+    real(wp), intent(in) :: stress(6, *)     !! Cauchy stresses
+    real(wp), intent(inout) :: f(2, *)       !! nodal forces (accumulated)
+    real(wp) :: sx(2), sy(2)
+    integer :: p, k, I
+    do p = p0, p1
+      ! Columns of V σ: f_I −= sx ∂xN + sy ∂yN.
+      sx(1) = vol(p) * stress(1, p); sx(2) = vol(p) * stress(6, p)
+      sy(1) = sx(2); sy(2) = vol(p) * stress(2, p)
+      do k = 1, nn(p)
+        I = node(k, p)
+        f(:, I) = f(:, I) - (sx * dN(1, k, p) + sy * dN(2, k, p))
+      end do
+    end do
+  end subroutine internal_force_2d
+
+  !> L_p = Σ v_I ⊗ ∇N_Ip, the 2×2 block of the 3×3 gradient.
+  pure subroutine velocity_gradient_2d(mx, p0, p1, nn, node, dN, v, L)
+    integer, intent(in) :: mx                !! basis capacity
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: dN(2, mx, *)     !! shape-function gradients
+    real(wp), intent(in) :: v(2, *)          !! nodal velocities
+    real(wp), intent(inout) :: L(3, 3, *)    !! velocity gradients (2×2 block written)
+    real(wp) :: gx(2), gy(2)
+    integer :: p, k, I
+    do p = p0, p1
+      gx = 0.0_wp; gy = 0.0_wp
+      do k = 1, nn(p)
+        I = node(k, p)
+        gx = gx + v(:, I) * dN(1, k, p)
+        gy = gy + v(:, I) * dN(2, k, p)
+      end do
+      L(1:2, 1, p) = gx; L(1:2, 2, p) = gy
+    end do
+  end subroutine velocity_gradient_2d
+
+  !> u_p = Σ N_Ip q_I.
+  pure subroutine g2p_value_2d(mx, p0, p1, nn, node, N, q, u)
+    integer, intent(in) :: mx                !! basis capacity
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: N(mx, *)         !! shape-function values
+    real(wp), intent(in) :: q(2, *)          !! nodal vectors
+    real(wp), intent(inout) :: u(2, *)       !! particle vectors (overwritten)
+    real(wp) :: s(2)
+    integer :: p, k
+    do p = p0, p1
+      s = 0.0_wp
+      do k = 1, nn(p)
+        s = s + N(k, p) * q(:, node(k, p))
+      end do
+      u(:, p) = s
+    end do
+  end subroutine g2p_value_2d
+
+  !> u_p += c Σ N_Ip q_I.
+  pure subroutine g2p_add_scaled_2d(mx, p0, p1, nn, node, N, c, q, u)
+    integer, intent(in) :: mx                !! basis capacity
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: N(mx, *)         !! shape-function values
+    real(wp), intent(in) :: c                !! scale
+    real(wp), intent(in) :: q(2, *)          !! nodal vectors
+    real(wp), intent(inout) :: u(2, *)       !! particle vectors (accumulated)
+    real(wp) :: s(2)
+    integer :: p, k
+    do p = p0, p1
+      s = 0.0_wp
+      do k = 1, nn(p)
+        s = s + N(k, p) * q(:, node(k, p))
+      end do
+      u(:, p) = u(:, p) + c * s
+    end do
+  end subroutine g2p_add_scaled_2d
+
+  !> The Newmark-consistent predictor-corrector particle update (see [[g2p_pc_newmark]]).
+  pure subroutine g2p_pc_newmark_2d(mx, p0, p1, nn, node, N, dt, g, vel, acc, x, v, a)
+    integer, intent(in) :: mx                !! basis capacity
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: N(mx, *)         !! shape-function values
+    real(wp), intent(in) :: dt               !! time step [s]
+    real(wp), intent(in) :: g                !! Newmark γ
+    real(wp), intent(in) :: vel(2, *)        !! predicted nodal velocities v*_I
+    real(wp), intent(in) :: acc(2, *)        !! nodal accelerations a_I
+    real(wp), intent(inout) :: x(2, *)       !! particle positions
+    real(wp), intent(inout) :: v(2, *)       !! particle velocities
+    real(wp), intent(inout) :: a(2, *)       !! particle accelerations: a^n in, a^{n+1} out
+    real(wp) :: sv(2), sa(2), cx, cv0, cv1, nk
+    integer :: p, k, I
+    ! The generic kernel's coefficients, formed in its evaluation order.
+    cx = (g - 0.5_wp) * dt * dt; cv0 = (1.0_wp - g) * dt; cv1 = g * dt
+    do p = p0, p1
+      sv = 0.0_wp; sa = 0.0_wp
+      do k = 1, nn(p)
+        I = node(k, p); nk = N(k, p)
+        sv = sv + nk * vel(:, I)
+        sa = sa + nk * acc(:, I)
+      end do
+      x(:, p) = x(:, p) + dt * sv + cx * a(:, p)
+      v(:, p) = v(:, p) + cv0 * a(:, p) + cv1 * sa
+      a(:, p) = sa
+    end do
+  end subroutine g2p_pc_newmark_2d
+end module empm_transfer_2d
