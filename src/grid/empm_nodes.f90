@@ -22,6 +22,7 @@ module empm_nodes
   contains
     procedure :: alloc => nodes_alloc
     procedure :: reset => nodes_reset
+    procedure :: reset_p2g => nodes_reset_p2g
     procedure :: fix_box => nodes_fix_box
   end type empm_nodes_t
 
@@ -45,11 +46,27 @@ contains
   !> Zero every nodal field (step 9 of the paper's algorithm); constraints are kept.
   subroutine nodes_reset(self)
     class(empm_nodes_t), intent(inout) :: self !! nodal fields
-    ! Whole-array assignments: one contiguous fill per field (per-node slices of run-time
-    ! length cost a library call each).
-    self%mass = 0.0_wp; self%mom = 0.0_wp; self%vel = 0.0_wp
-    self%force = 0.0_wp; self%acc = 0.0_wp
+    ! Each field as one contiguous block (assigning through the polymorphic `self` compiles
+    ! to one library call per node column).
+    call zero(self%mass, size(self%mass)); call zero(self%mom, size(self%mom))
+    call zero(self%vel, size(self%vel)); call zero(self%force, size(self%force))
+    call zero(self%acc, size(self%acc))
   end subroutine nodes_reset
+
+  !> Zero only the fields a step accumulates into by P2G before it overwrites the others: mass
+  !> and momentum (force is zeroed where it is assembled; velocity and acceleration are written
+  !> at every node by the nodal update). Enough for schemes that accumulate nothing else.
+  subroutine nodes_reset_p2g(self)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields
+    call zero(self%mass, size(self%mass)); call zero(self%mom, size(self%mom))
+  end subroutine nodes_reset_p2g
+
+  !> a = 0 over n contiguous entries.
+  pure subroutine zero(a, n)
+    integer, intent(in) :: n       !! number of entries
+    real(wp), intent(out) :: a(n)  !! array
+    a = 0.0_wp
+  end subroutine zero
 
   !> Constrain components `comp` of every node inside the closed box [lo, hi] (a node set by
   !> geometry) to the velocity `value`. Returns the number of nodes selected. Allocates the

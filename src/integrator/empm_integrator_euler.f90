@@ -55,7 +55,7 @@ contains
       call eval_basis(model, stat, tm, self%p2g)
       call tm%lap(PHASE_SHAPE)
       if (stat%code /= STEP_OK) return
-      call nodes%reset()
+      call nodes%reset_p2g()
       call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
                              self%p2g)
       call tm%lap(PHASE_P2G)

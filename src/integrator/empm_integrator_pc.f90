@@ -68,7 +68,7 @@ contains
       call eval_basis(model, stat, tm, self%p2g)
       call tm%lap(PHASE_SHAPE)
       if (stat%code /= STEP_OK) return
-      call nodes%reset()
+      call nodes%reset_p2g()
       ! Mass and predictor in one pass, the predictor formed from particle data (eq. 31) to
       ! avoid dividing accelerations.
       call p2g_mass_momentum(basis, pts%m, pts%v, (1.0_wp - g) * dt, pts%a, nodes%mass, &

@@ -204,12 +204,14 @@ contains
         ibad = min(ibad, p)
         cycle
       end if
+      ! Inside the box, s ≥ 0: floor is int, and s − i0 ≥ 0 needs no clamp from below (the
+      ! same values as linear_2d).
       s1 = (x(1, p) - o1) * h1
       s2 = (x(2, p) - o2) * h2
-      i0 = min(max(floor(s1), 0), c1)
-      j0 = min(max(floor(s2), 0), c2)
-      t1 = min(max(s1 - i0, 0.0_wp), 1.0_wp); u1 = 1.0_wp - t1
-      t2 = min(max(s2 - j0, 0.0_wp), 1.0_wp); u2 = 1.0_wp - t2
+      i0 = min(int(s1), c1)
+      j0 = min(int(s2), c2)
+      t1 = min(s1 - i0, 1.0_wp); u1 = 1.0_wp - t1
+      t2 = min(s2 - j0, 1.0_wp); u2 = 1.0_wp - t2
       id = 1 + i0 + n1 * j0
       nn(p) = 4
       node(1, p) = id; node(2, p) = id + 1; node(3, p) = id + n1; node(4, p) = id + n1 + 1
