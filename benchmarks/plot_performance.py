@@ -15,8 +15,10 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 PHASES = ["shape", "p2g", "grid", "g2p", "stress"]
-# Issue #6 targets: one core, Release (particle-steps per second).
+# Issue #6 targets: one core, Release (particle-steps per second; callgrind instructions per
+# particle-step).
 TARGETS = [(2, "linear", 8e6), (2, "lme_g3", 1e6), (2, "lme_g0.8", 2.5e5), (3, "lme_g3", 2e5)]
+INSTR_TARGETS = {"linear": 500, "lme_g3": 5000}
 
 
 def load(path):
@@ -50,6 +52,7 @@ def main():
     matrix = [r for r in rows if r["tag"] == "matrix"]
     sweep = [r for r in rows if r["tag"] == "sweep"]
     speed = [r for r in rows if r["tag"] == "speedup"]
+    grind = [r for r in rows if r["tag"] == "callgrind"]
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
     for shape, style in [("linear", "o-"), ("lme_g3", "s-")]:
@@ -111,6 +114,12 @@ def main():
         b = r[0]["bytes_per_particle"]
         md.append(f"| bytes per particle, 2D lme_g3 | <= 1024 | {b:.0f} | "
                   f"{'yes' if b <= 1024 else 'no'} |")
+    for r in grind:
+        t = INSTR_TARGETS.get(r["shape"])
+        if t:
+            v = r["instructions_per_particle_step"]
+            md.append(f'| callgrind, 2D {r["shape"]}, instructions per particle-step | <= {t} | '
+                      f'{v:.0f} | {"yes" if v <= t else "no"} |')
     md += ["", "## Matrix", "",
            "| dim | shape | threads | particles | nodes | steps | particle-steps/s | Newton/step "
            "| bytes/particle | " + " | ".join(f"{p} %" for p in PHASES) + " |",
@@ -126,6 +135,17 @@ def main():
     for r in sorted(sweep, key=lambda x: (x["shape"], x["particles"])):
         md.append(f'| {r["shape"]} | {r["particles"]} | {r["steps"]} | '
                   f'{fmt(r["particle_steps_per_second"])} | {r["bytes_per_particle"]:.0f} |')
+    if grind:
+        md += ["", "## Instructions per particle-step (callgrind)", "",
+               "`benchmarks/callgrind_count.py`: 2D, 4096 particles, pc_newmark, 1 thread; the "
+               "difference of a 6-step and a 2-step run (same warm-up) per particle-step, and its "
+               "split by function (>= 5 instructions).", ""]
+        for r in grind:
+            md += [f'**{r["shape"]}**: {r["instructions_per_particle_step"]:.0f} instructions '
+                   f'per particle-step (Newton iterations {r["newton_iterations_mean"]:.2f})', "",
+                   "| function | instructions |", "|---|---|"]
+            md += [f"| `{k}` | {v:.0f} |" for k, v in r["by_function"].items()]
+            md.append("")
     md += ["", "## Two threads (2D, 262144 particles)", "",
            "| shape | threads | particle-steps/s |", "|---|---|---|"]
     for r in speed:

@@ -31,6 +31,12 @@
 !> hull boundary), where reproduction then holds to 1e-10 h. The returned p are the p̃, and
 !> r, J below are their moments (r ≈ 1e-16).
 !>
+!> **2D batch path.** `eval_batch` in 2D with uniform γ uses [[lme_point_2d]]: the same
+!> algorithm in three passes over the support, stopping Newton early when a bound proves the
+!> residual after the final step below the tolerance, with values made exactly consistent by a
+!> 2×2 solve (docs/shape-functions.md, "The 2D batch path"); anything unusual falls back to the
+!> general path above.
+!>
 !> **Gradient.** With uniform γ: ∇p_a = −p_a J⁻¹ (ξ_a − r)/h, which equals −p_a J⁻¹ l_a at the
 !> exact λ* (r = 0); keeping −r makes Σ∇p_a = 0 and Σ x_a⊗∇p_a = I hold to round-off. With
 !> node-wise γ_a (β_a = γ_a/h²), f_a = −γ_a|ξ_a|² + λ·ξ_a; differentiate r(x, λ*(x)) = 0
