@@ -62,10 +62,15 @@ contains
   end subroutine nodes_reset_p2g
 
   !> a = 0 over n contiguous entries.
-  pure subroutine zero(a, n)
+  subroutine zero(a, n)
     integer, intent(in) :: n       !! number of entries
     real(wp), intent(out) :: a(n)  !! array
-    a = 0.0_wp
+    integer :: i
+    !$omp parallel do schedule(static) if(n >= 65536)
+    do i = 1, n
+      a(i) = 0.0_wp
+    end do
+    !$omp end parallel do
   end subroutine zero
 
   !> Constrain components `comp` of every node inside the closed box [lo, hi] (a node set by

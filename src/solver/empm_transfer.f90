@@ -66,14 +66,24 @@ contains
   subroutine p2g_work_set_ranges(self, basis)
     class(empm_p2g_work_t), intent(inout) :: self !! workspace
     type(empm_basis_t), intent(in) :: basis       !! shape functions at the particles
-    integer :: c, p0, p1
+    integer :: c, p0, p1, p, k, lo, hi
     if (self%nt <= 1) return
-    !$omp parallel do num_threads(self%nt) schedule(static, 1) private(p0, p1)
+    ! Chunk by chunk, each one's particles shared by all threads (a loop over the chunks
+    ! would leave one thread alone with chunk 2 when there are two).
     do c = 2, self%nt
       call chunk_bounds(basis%np, self%nt, c - 1, p0, p1)
-      call node_range(basis, p0, p1, self%lo(c), self%hi(c))
+      lo = huge(1); hi = 0
+      !$omp parallel do num_threads(self%nt) schedule(static) private(k) &
+      !$omp   reduction(min: lo) reduction(max: hi)
+      do p = p0, p1
+        do k = 1, basis%nn(p)
+          lo = min(lo, basis%node(k, p)); hi = max(hi, basis%node(k, p))
+        end do
+      end do
+      !$omp end parallel do
+      if (hi == 0) lo = 1
+      self%lo(c) = lo; self%hi(c) = hi
     end do
-    !$omp end parallel do
   end subroutine p2g_work_set_ranges
 
   !> True when a P2G call runs on per-thread chunks (a workspace with more than one chunk).
@@ -90,21 +100,6 @@ contains
     p0 = int(int(np, int64) * c / n) + 1
     p1 = int(int(np, int64) * (c + 1) / n)
   end subroutine chunk_bounds
-
-  !> Node range touched by particles p0..p1 (empty range lo > hi when there are none).
-  pure subroutine node_range(basis, p0, p1, lo, hi)
-    type(empm_basis_t), intent(in) :: basis
-    integer, intent(in) :: p0, p1
-    integer, intent(out) :: lo, hi
-    integer :: p, k
-    lo = huge(1); hi = 0
-    do p = p0, p1
-      do k = 1, basis%nn(p)
-        lo = min(lo, basis%node(k, p)); hi = max(hi, basis%node(k, p))
-      end do
-    end do
-    if (hi == 0) lo = 1
-  end subroutine node_range
 
   !> Add the chunk buffers to `q` (in chunk order) and zero them again.
   subroutine reduce_vec(ws, q)
