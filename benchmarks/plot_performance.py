@@ -53,6 +53,7 @@ def main():
     sweep = [r for r in rows if r["tag"] == "sweep"]
     speed = [r for r in rows if r["tag"] == "speedup"]
     grind = [r for r in rows if r["tag"] == "callgrind"]
+    bw = [r for r in rows if r["tag"] == "bandwidth"]
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
     for shape, style in [("linear", "o-"), ("lme_g3", "s-")]:
@@ -146,6 +147,12 @@ def main():
                    "| function | instructions |", "|---|---|"]
             md += [f"| `{k}` | {v:.0f} |" for k, v in r["by_function"].items()]
             md.append("")
+    if bw:
+        md += ["", "## Memory bandwidth (STREAM triad, `benchmarks/bandwidth`)", "",
+               "| threads | GB/s (each run) |", "|---|---|"]
+        for t in sorted({r["threads"] for r in bw}):
+            rates = ", ".join(f"{r['gb_per_s']:.1f}" for r in bw if r["threads"] == t)
+            md.append(f"| {t} | {rates} |")
     md += ["", "## Two threads (2D, 262144 particles)", "",
            "| shape | threads | particle-steps/s |", "|---|---|---|"]
     for r in speed:
