@@ -20,7 +20,7 @@ module empm_transfer
   use empm_nodes, only: empm_nodes_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_max_threads
   use empm_transfer_2d, only: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, &
-                              g2p_value_2d, g2p_add_scaled_2d, g2p_pc_newmark_2d
+                              g2p_2d, g2p_pc_newmark_2d
   implicit none
   private
   public :: empm_p2g_work_t
@@ -398,7 +398,7 @@ contains
     do c = 0, nc - 1
       call chunk_bounds(basis%np, nc, c, p0, p1)
       if (basis%ndim == 2) then
-        call g2p_value_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, u)
+        call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .false., 0.0_wp, u)
         cycle
       end if
       do p = p0, p1
@@ -425,7 +425,7 @@ contains
     do ic = 0, nc - 1
       call chunk_bounds(basis%np, nc, ic, p0, p1)
       if (d == 2) then
-        call g2p_add_scaled_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, c, q, u)
+        call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .true., c, u)
         cycle
       end if
       do p = p0, p1

@@ -13,8 +13,8 @@ module empm_transfer_2d
   use empm_kinds, only: wp
   implicit none
   private
-  public :: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, g2p_value_2d, &
-            g2p_add_scaled_2d, g2p_pc_newmark_2d
+  public :: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, g2p_2d, &
+            g2p_pc_newmark_2d
 
 contains
 
@@ -96,16 +96,18 @@ contains
     end do
   end subroutine velocity_gradient_2d
 
-  !> u_p = Σ N_Ip q_I.
-  pure subroutine g2p_value_2d(mx, p0, p1, nn, node, N, q, u)
-    integer, intent(in) :: mx                !! basis capacity
+  !> u_p = Σ N_Ip q_I, or with `add` u_p += c Σ N_Ip q_I.
+  pure subroutine g2p_2d(mx, p0, p1, nn, node, N, q, add, c, u)
+    integer, intent(in) :: mx                !! basis capacity (nodes per particle)
     integer, intent(in) :: p0                !! first particle
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: nn(*)             !! nodes per particle
     integer, intent(in) :: node(mx, *)       !! node indices
     real(wp), intent(in) :: N(mx, *)         !! shape-function values
     real(wp), intent(in) :: q(2, *)          !! nodal vectors
-    real(wp), intent(inout) :: u(2, *)       !! particle vectors (overwritten)
+    logical, intent(in) :: add               !! accumulate c Σ N q instead of overwriting
+    real(wp), intent(in) :: c                !! scale (with `add`)
+    real(wp), intent(inout) :: u(2, *)       !! particle vectors
     real(wp) :: s(2)
     integer :: p, k
     do p = p0, p1
@@ -113,31 +115,13 @@ contains
       do k = 1, nn(p)
         s = s + N(k, p) * q(:, node(k, p))
       end do
-      u(:, p) = s
+      if (add) then
+        u(:, p) = u(:, p) + c * s
+      else
+        u(:, p) = s
+      end if
     end do
-  end subroutine g2p_value_2d
-
-  !> u_p += c Σ N_Ip q_I.
-  pure subroutine g2p_add_scaled_2d(mx, p0, p1, nn, node, N, c, q, u)
-    integer, intent(in) :: mx                !! basis capacity
-    integer, intent(in) :: p0                !! first particle
-    integer, intent(in) :: p1                !! last particle
-    integer, intent(in) :: nn(*)             !! nodes per particle
-    integer, intent(in) :: node(mx, *)       !! node indices
-    real(wp), intent(in) :: N(mx, *)         !! shape-function values
-    real(wp), intent(in) :: c                !! scale
-    real(wp), intent(in) :: q(2, *)          !! nodal vectors
-    real(wp), intent(inout) :: u(2, *)       !! particle vectors (accumulated)
-    real(wp) :: s(2)
-    integer :: p, k
-    do p = p0, p1
-      s = 0.0_wp
-      do k = 1, nn(p)
-        s = s + N(k, p) * q(:, node(k, p))
-      end do
-      u(:, p) = u(:, p) + c * s
-    end do
-  end subroutine g2p_add_scaled_2d
+  end subroutine g2p_2d
 
   !> The Newmark-consistent predictor-corrector particle update (see [[g2p_pc_newmark]]).
   pure subroutine g2p_pc_newmark_2d(mx, p0, p1, nn, node, N, dt, g, vel, acc, x, v, a)
