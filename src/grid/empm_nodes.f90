@@ -22,7 +22,6 @@ module empm_nodes
   contains
     procedure :: alloc => nodes_alloc
     procedure :: reset => nodes_reset
-    procedure :: reset_p2g => nodes_reset_p2g
     procedure :: fix_box => nodes_fix_box
   end type empm_nodes_t
 
@@ -40,26 +39,20 @@ contains
     allocate(self%mass(n), self%mom(d, n), self%vel(d, n), self%force(d, n), self%acc(d, n), &
       self%work(d, n), self%fixed(d, n), self%vfix(d, n))
     self%fixed = .false.; self%vfix = 0.0_wp
-    call self%reset()
+    call zero(self%mass, n); call zero(self%mom, d * n); call zero(self%vel, d * n)
+    call zero(self%force, d * n); call zero(self%acc, d * n); call zero(self%work, d * n)
   end subroutine nodes_alloc
 
-  !> Zero every nodal field (step 9 of the paper's algorithm); constraints are kept.
+  !> Zero the fields P2G accumulates into, mass and momentum (step 9 of the paper's
+  !> algorithm); constraints are kept. The other nodal fields are outputs, written at every node
+  !> by the pass that computes them (force is zeroed where it is assembled); a scheme that
+  !> accumulates into one of them zeroes it itself.
   subroutine nodes_reset(self)
     class(empm_nodes_t), intent(inout) :: self !! nodal fields
     ! Each field as one contiguous block (assigning through the polymorphic `self` compiles
     ! to one library call per node column).
     call zero(self%mass, size(self%mass)); call zero(self%mom, size(self%mom))
-    call zero(self%vel, size(self%vel)); call zero(self%force, size(self%force))
-    call zero(self%acc, size(self%acc))
   end subroutine nodes_reset
-
-  !> Zero only the fields a step accumulates into by P2G before it overwrites the others: mass
-  !> and momentum (force is zeroed where it is assembled; velocity and acceleration are written
-  !> at every node by the nodal update). Enough for schemes that accumulate nothing else.
-  subroutine nodes_reset_p2g(self)
-    class(empm_nodes_t), intent(inout) :: self !! nodal fields
-    call zero(self%mass, size(self%mass)); call zero(self%mom, size(self%mom))
-  end subroutine nodes_reset_p2g
 
   !> a = 0 over n contiguous entries.
   subroutine zero(a, n)

@@ -4,17 +4,17 @@
 !> A scheme implements `step`, which advances the model by Δt. Adding a scheme means adding
 !> one file that extends [[empm_integrator_t]] and one line in [[empm_integrator_factory]].
 module empm_integrator
-  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_SHAPE_FAILED, &
                         STEP_MATERIAL_FAILED
-  use empm_transfer, only: p2g_mass, p2g_internal_force, p2g_body_force, constrain_force, &
-                           nodal_divide_by_mass, g2p_value, empm_p2g_work_t
-  use empm_timer, only: empm_phase_timer_t
-  use empm_parallel, only: empm_max_threads, EMPM_OMP_MIN_PARTICLES
+  use empm_transfer, only: p2g_mass, p2g_mass_momentum, p2g_internal_force, p2g_body_force, &
+                           constrain_force, constrain_velocity, nodal_divide_by_mass, g2p_value, &
+                           empm_p2g_work_t
+  use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID
+  use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds, EMPM_OMP_MIN_PARTICLES
   implicit none
   private
-  public :: empm_integrator_t, eval_basis, update_stress, initial_acceleration
+  public :: empm_integrator_t, eval_basis, map_velocity, update_stress, initial_acceleration
 
   !> Abstract explicit integrator. Work arrays are allocated once in `prepare`.
   type, abstract :: empm_integrator_t
@@ -110,6 +110,36 @@ contains
     end if
   end subroutine eval_basis
 
+  !> The opening of every scheme's step, timed as its shape, P2G and grid phases: shape
+  !> functions at the particles; mass and mass-weighted velocity v_p + c w_p on the grid in one
+  !> pass (without `c` and `w`: the momentum); nodal velocity = that / mass with the Dirichlet
+  !> values imposed (nodes%vel, and nodes%mom to match). On a shape failure `stat` says which
+  !> particle and nothing else is done.
+  subroutine map_velocity(self, model, stat, c, w)
+    class(empm_integrator_t), intent(inout) :: self   !! integrator (timer, P2G workspace)
+    type(empm_model_t), intent(inout) :: model        !! simulation state
+    type(empm_step_status_t), intent(inout) :: stat   !! set on failure
+    real(wp), intent(in), optional :: c               !! scale of `w`
+    real(wp), intent(in), contiguous, optional :: w(:,:) !! second particle vectors (ndim, np)
+    associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
+      call tm%mark()
+      call eval_basis(model, stat, tm, self%p2g)
+      call tm%lap(PHASE_SHAPE)
+      if (stat%code /= 0) return
+      call nodes%reset()
+      if (present(c) .and. present(w)) then
+        call p2g_mass_momentum(basis, pts%m, pts%v, c, w, nodes%mass, nodes%mom, self%p2g)
+      else
+        call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
+                               self%p2g)
+      end if
+      call tm%lap(PHASE_P2G)
+      call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
+      call constrain_velocity(nodes, nodes%vel, nodes%mom)
+      call tm%lap(PHASE_GRID)
+    end associate
+  end subroutine map_velocity
+
   !> Total nodal force at time `t` (paper eqs. 16–17): reset, internal force from the current
   !> stresses, gravity and the body-force callback; zeroed on fixed dofs.
   subroutine assemble_forces(self, model, t)
@@ -118,20 +148,17 @@ contains
     real(wp), intent(in) :: t                       !! time at which loads are evaluated [s]
     real(wp) :: g(3)
     integer :: np, d
+    logical :: use_b
     np = model%pts%np; d = model%grid%ndim
     model%nodes%force = 0.0_wp
     call p2g_internal_force(model%basis, model%pts%vol, model%pts%stress, model%nodes%force, &
                             self%p2g)
     g = model%loads%gravity_at(t)
-    if (allocated(model%loads%body_force)) then
-      call model%loads%body_force%eval(t, model%pts%x0(:, 1:np), model%pts%x(:, 1:np), &
-                                  self%bwork(:, 1:np))
-      call p2g_body_force(model%basis, model%pts%m, g(1:d), self%bwork, .true., &
-                          model%nodes%force, self%p2g)
-    else
-      call p2g_body_force(model%basis, model%pts%m, g(1:d), self%bwork, .false., &
-                          model%nodes%force, self%p2g)
-    end if
+    use_b = allocated(model%loads%body_force)
+    if (use_b) call model%loads%body_force%eval(t, model%pts%x0(:, 1:np), &
+                                                model%pts%x(:, 1:np), self%bwork(:, 1:np))
+    call p2g_body_force(model%basis, model%pts%m, g(1:d), self%bwork, use_b, model%nodes%force, &
+                        self%p2g)
     call constrain_force(model%nodes, model%nodes%force)
   end subroutine assemble_forces
 
@@ -147,13 +174,13 @@ contains
       i0 = model%run_first(r); i1 = model%run_last(r)
       im = model%pts%mat(i0)
       n = i1 - i0 + 1
-      nc = 1
-      if (n >= EMPM_OMP_MIN_PARTICLES) nc = empm_max_threads()
+      nc = empm_chunks(n)
       ! The first failing particle of the run, whichever slice it is in.
       bad = huge(1)
       !$omp parallel do schedule(static, 1) private(a, b, info) reduction(min: bad) if(nc > 1)
       do c = 0, nc - 1
-        a = i0 + int(int(n, int64) * c / nc); b = i0 + int(int(n, int64) * (c + 1) / nc) - 1
+        call empm_chunk_bounds(n, nc, c, a, b)
+        a = a + i0 - 1; b = b + i0 - 1
         call model%mats(im)%model%update(dt, model%pts%L(:, :, a:b), model%pts%F(:, :, a:b), &
           model%pts%strain(:, a:b), model%pts%stress(:, a:b), model%pts%rho(a:b), info)
         if (info /= 0) bad = min(bad, a + info - 1)

@@ -10,11 +10,11 @@
 !> - MUSL: after the particle update, with velocities re-mapped from the updated particles.
 module empm_integrator_euler
   use empm_kinds, only: wp
-  use empm_integrator, only: empm_integrator_t, eval_basis, update_stress
+  use empm_integrator, only: empm_integrator_t, map_velocity, update_stress
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
-  use empm_transfer, only: p2g_mass_momentum, p2g_weighted, g2p_add_scaled, g2p_value, &
+  use empm_transfer, only: p2g_weighted, g2p_add_scaled, g2p_value, &
                            velocity_gradient, nodal_divide_by_mass, constrain_velocity
-  use empm_timer, only: PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
+  use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
   public :: empm_euler_t, EULER_USF, EULER_USL, EULER_MUSL
@@ -51,17 +51,8 @@ contains
     real(wp), intent(in) :: dt                      !! time step [s]
     type(empm_step_status_t), intent(out) :: stat   !! outcome
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
-      call tm%mark()
-      call eval_basis(model, stat, tm, self%p2g)
-      call tm%lap(PHASE_SHAPE)
+      call map_velocity(self, model, stat)
       if (stat%code /= STEP_OK) return
-      call nodes%reset_p2g()
-      call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
-                             self%p2g)
-      call tm%lap(PHASE_P2G)
-      call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
-      call constrain_velocity(nodes, nodes%vel, nodes%mom)
-      call tm%lap(PHASE_GRID)
 
       if (self%variant == EULER_USF) then
         call velocity_gradient(basis, nodes%vel, pts%L)

@@ -10,12 +10,12 @@
 !> 5. L_p = Σ (Δu_I/Δt) ⊗ ∇N: the strain increment matches the displacement of step 4.
 module empm_integrator_genalpha
   use empm_kinds, only: wp
-  use empm_integrator, only: empm_integrator_t, eval_basis, update_stress, initial_acceleration
+  use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
-  use empm_transfer, only: p2g_mass_momentum, p2g_weighted, g2p_add_scaled, g2p_value, &
-                           velocity_gradient, nodal_divide_by_mass, constrain_velocity, &
+  use empm_transfer, only: p2g_weighted, g2p_add_scaled, g2p_value, &
+                           velocity_gradient, nodal_divide_by_mass, &
                            constrain_force
-  use empm_timer, only: PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
+  use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
   public :: empm_genalpha_t, genalpha_parameters
@@ -67,18 +67,10 @@ contains
     real(wp) :: am, be, ga
     call genalpha_parameters(self%rho_b, am, be, ga)
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
-      call tm%mark()
-      call eval_basis(model, stat, tm, self%p2g)
-      call tm%lap(PHASE_SHAPE)
+      call map_velocity(self, model, stat)
       if (stat%code /= STEP_OK) return
-      call nodes%reset()
-      call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
-                             self%p2g)
-      call tm%lap(PHASE_P2G)
-      call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
-      call constrain_velocity(nodes, nodes%vel, nodes%mom)
-      call tm%lap(PHASE_GRID)
-      ! a_I^k in nodes%work (mass-weighted map of particle accelerations).
+      ! a_I^k in nodes%work (mass-weighted map of particle accelerations, accumulated in acc).
+      nodes%acc = 0.0_wp
       call p2g_weighted(basis, pts%m, pts%a, 0.0_wp, pts%a, nodes%acc, self%p2g)
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%acc, nodes%work)

@@ -13,11 +13,11 @@
 !>                  x_p += Δt Σ N v*_I + (γ − ½)Δt² a_p, a_p = a⁺
 module empm_integrator_pc
   use empm_kinds, only: wp
-  use empm_integrator, only: empm_integrator_t, eval_basis, update_stress, initial_acceleration
+  use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
-  use empm_transfer, only: p2g_mass_momentum, g2p_add_scaled, g2p_value, g2p_pc_newmark, &
-                           velocity_gradient, nodal_divide_by_mass, constrain_velocity
-  use empm_timer, only: PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
+  use empm_transfer, only: g2p_add_scaled, g2p_value, g2p_pc_newmark, &
+                           velocity_gradient, nodal_divide_by_mass
+  use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
   public :: empm_pc_t, PC_PUBLISHED, PC_NEWMARK
@@ -64,19 +64,9 @@ contains
     real(wp) :: g
     g = self%gamma
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
-      call tm%mark()
-      call eval_basis(model, stat, tm, self%p2g)
-      call tm%lap(PHASE_SHAPE)
+      ! Predictor v*_I, formed from particle data (eq. 31) to avoid dividing accelerations.
+      call map_velocity(self, model, stat, (1.0_wp - g) * dt, pts%a)
       if (stat%code /= STEP_OK) return
-      call nodes%reset_p2g()
-      ! Mass and predictor in one pass, the predictor formed from particle data (eq. 31) to
-      ! avoid dividing accelerations.
-      call p2g_mass_momentum(basis, pts%m, pts%v, (1.0_wp - g) * dt, pts%a, nodes%mass, &
-                             nodes%mom, self%p2g)
-      call tm%lap(PHASE_P2G)
-      call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
-      call constrain_velocity(nodes, nodes%vel, nodes%mom)
-      call tm%lap(PHASE_GRID)
       ! Strain increment and stress with the predicted velocity.
       call velocity_gradient(basis, nodes%vel, pts%L)
       call update_stress(model, dt, stat)

@@ -10,7 +10,7 @@ module empm_shape_linear
   use empm_kinds, only: wp
   use empm_grid, only: empm_grid_t
   use empm_particles, only: empm_particles_t
-  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
+  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES
   implicit none
@@ -77,13 +77,28 @@ contains
     type(empm_basis_t), intent(inout) :: basis     !! filled for particles 1..pts%np
     integer, intent(out) :: ibad                   !! first failing particle, 0 if none
     integer, intent(out) :: info                   !! SHAPE_OK or the failing particle's code
-    integer :: p, pinfo
+    integer :: p, pinfo, nc, c, p0, p1, b
     associate (unused_ => self); end associate
     call shape_batch_fits(pts%np, basis, ibad, info)
     if (info /= SHAPE_OK) return
     if (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4) then
-      call linear_batch_2d(grid, pts%np, pts%x, basis%maxn, basis%nn, basis%node, basis%N, &
-                           basis%dN, ibad, info)
+      ! 2D: one bilinear kernel call per chunk of particles.
+      nc = empm_chunks(pts%np)
+      ibad = huge(1)
+      !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, b) &
+      !$omp   reduction(min: ibad) if(nc > 1)
+      do c = 0, nc - 1
+        call empm_chunk_bounds(pts%np, nc, c, p0, p1)
+        call linear_range_2d(grid, p0, p1, pts%x, basis%maxn, basis%nn, basis%node, basis%N, &
+                             basis%dN, b)
+        ibad = min(ibad, b)
+      end do
+      !$omp end parallel do
+      if (ibad == huge(1)) then
+        ibad = 0
+      else
+        info = SHAPE_OUTSIDE_GRID
+      end if
       return
     end if
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
@@ -117,7 +132,7 @@ contains
     real(wp), intent(out) :: N(:)         !! values (capacity >= 2^ndim)
     real(wp), intent(out) :: dN(:,:)      !! gradients (ndim, capacity >= 2^ndim)
     integer, intent(out) :: info          !! SHAPE_OK, SHAPE_OUTSIDE_GRID, SHAPE_TOO_MANY_NODES
-    integer :: m(3), base(3), d, i0
+    integer :: m(3), base(3), d, i0, nn1(1), ibad
     real(wp) :: w(SHAPE_TP_MAXM, 3), g(SHAPE_TP_MAXM, 3), s, t
     nn = 0
     if (grid%ndim < 1) then
@@ -126,9 +141,11 @@ contains
     if (.not. grid%inside(x)) then
       info = SHAPE_OUTSIDE_GRID; return
     end if
-    if (grid%ndim == 2 .and. size(node) >= 4 .and. size(N) >= 4 .and. size(dN, 2) >= 4) then
-      call linear_2d(grid, x, node, N, dN)
-      nn = 4; info = SHAPE_OK; return
+    if (grid%ndim == 2 .and. size(node) >= 4 .and. size(N) >= 4 .and. size(dN, 1) >= 2 .and. &
+        size(dN, 2) >= 4) then
+      ! The batch kernel for this one point (x is inside: it cannot fail).
+      call linear_range_2d(grid, 1, 1, x(1:2), 4, nn1, node(1:4), N(1:4), dN(1:2, 1:4), ibad)
+      nn = nn1(1); info = SHAPE_OK; return
     end if
     call shape_tp_init(m, base, w, g)
     do d = 1, grid%ndim
@@ -147,44 +164,21 @@ contains
     call shape_tp_assemble(grid, m, base, w, g, nn, node, N, dN, info)
   end subroutine shape_linear_kernel
 
-  !> Bilinear (Q4) values and gradients written out: the hot path of 2D runs, without the
-  !> generic tensor-product assembly (same values, same node order, x fastest).
-  pure subroutine linear_2d(grid, x, node, N, dN)
-    type(empm_grid_t), intent(in) :: grid
-    real(wp), intent(in) :: x(:)
-    integer, intent(out) :: node(:)
-    real(wp), intent(out) :: N(:), dN(:,:)
-    real(wp) :: s1, s2, t1, t2, u1, u2, h1, h2
-    integer :: i0, j0, id
-    s1 = (x(1) - grid%origin(1)) * grid%inv_h(1)
-    s2 = (x(2) - grid%origin(2)) * grid%inv_h(2)
-    i0 = min(max(floor(s1), 0), grid%ncell(1) - 1)
-    j0 = min(max(floor(s2), 0), grid%ncell(2) - 1)
-    t1 = min(max(s1 - i0, 0.0_wp), 1.0_wp); u1 = 1.0_wp - t1
-    t2 = min(max(s2 - j0, 0.0_wp), 1.0_wp); u2 = 1.0_wp - t2
-    h1 = grid%inv_h(1); h2 = grid%inv_h(2)
-    id = 1 + i0 + grid%nn(1) * j0
-    node(1) = id; node(2) = id + 1; node(3) = id + grid%nn(1); node(4) = id + grid%nn(1) + 1
-    N(1) = u1 * u2; N(2) = t1 * u2; N(3) = u1 * t2; N(4) = t1 * t2
-    dN(1, 1) = -h1 * u2; dN(2, 1) = -u1 * h2
-    dN(1, 2) = h1 * u2;  dN(2, 2) = -t1 * h2
-    dN(1, 3) = -h1 * t2; dN(2, 3) = u1 * h2
-    dN(1, 4) = h1 * t2;  dN(2, 4) = t1 * h2
-  end subroutine linear_2d
-
-  !> Bilinear values and gradients at particles 1..np (the 2D batch of [[linear_eval_batch]]):
-  !> the expressions of [[linear_2d]] on explicit-shape arrays, with the grid-box test inline.
-  subroutine linear_batch_2d(grid, np, x, mx, nn, node, N, dN, ibad, info)
+  !> Bilinear (Q4) values and gradients at particles p0..p1, written out: the hot path of 2D
+  !> runs, without the generic tensor-product assembly (the same values and node order, x
+  !> fastest). A particle outside the closed grid box (the test of grid%inside, which a NaN
+  !> coordinate fails too) gets nn = 0; `ibad` is the first one, huge(1) if none.
+  pure subroutine linear_range_2d(grid, p0, p1, x, mx, nn, node, N, dN, ibad)
     type(empm_grid_t), intent(in) :: grid    !! background grid (2D)
-    integer, intent(in) :: np                !! number of particles
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
     real(wp), intent(in) :: x(2, *)          !! particle positions
     integer, intent(in) :: mx                !! basis capacity (>= 4)
     integer, intent(inout) :: nn(*)          !! nodes per particle
     integer, intent(inout) :: node(mx, *)    !! node indices
     real(wp), intent(inout) :: N(mx, *)      !! values
     real(wp), intent(inout) :: dN(2, mx, *)  !! gradients
-    integer, intent(out) :: ibad             !! first particle outside the grid, 0 if none
-    integer, intent(out) :: info             !! SHAPE_OK or SHAPE_OUTSIDE_GRID
+    integer, intent(out) :: ibad             !! first particle outside the grid, huge(1) if none
     real(wp) :: o1, o2, e1, e2, h1, h2, s1, s2, t1, t2, u1, u2
     integer :: p, i0, j0, id, n1, c1, c2
     o1 = grid%origin(1); o2 = grid%origin(2)
@@ -193,19 +187,15 @@ contains
     h1 = grid%inv_h(1); h2 = grid%inv_h(2)
     n1 = grid%nn(1); c1 = grid%ncell(1) - 1; c2 = grid%ncell(2) - 1
     ibad = huge(1)
-    info = SHAPE_OK
-    !$omp parallel do schedule(static) private(i0, j0, id, s1, s2, t1, t2, u1, u2) &
-    !$omp   reduction(min: ibad) if(np >= EMPM_OMP_MIN_PARTICLES)
-    do p = 1, np
-      ! The test of grid%inside, as there (a NaN coordinate fails it).
+    do p = p0, p1
       if (.not. (x(1, p) >= o1 .and. x(1, p) <= e1 .and. x(2, p) >= o2 .and. &
                  x(2, p) <= e2)) then
         nn(p) = 0
         ibad = min(ibad, p)
         cycle
       end if
-      ! Inside the box, s ≥ 0: floor is int, and s − i0 ≥ 0 needs no clamp from below (the
-      ! same values as linear_2d).
+      ! Inside the box, s ≥ 0: floor is int, and s − i0 ≥ 0 needs no clamp from below; the
+      ! upper face belongs to the last cell.
       s1 = (x(1, p) - o1) * h1
       s2 = (x(2, p) - o2) * h2
       i0 = min(int(s1), c1)
@@ -221,13 +211,7 @@ contains
       dN(1, 3, p) = -h1 * t2; dN(2, 3, p) = u1 * h2
       dN(1, 4, p) = h1 * t2;  dN(2, 4, p) = t1 * h2
     end do
-    !$omp end parallel do
-    if (ibad == huge(1)) then
-      ibad = 0
-    else
-      info = SHAPE_OUTSIDE_GRID
-    end if
-  end subroutine linear_batch_2d
+  end subroutine linear_range_2d
 
   !> Reset tensor-product factors to the neutral values used along directions beyond ndim:
   !> one node at index 0 with value 1 and derivative 0.

@@ -10,15 +10,16 @@
 !> thread count (reproducible run to run) and equal to the serial sums to round-off; with one
 !> thread, or without a workspace, they are the serial sums bit for bit.
 !>
-!> Every kernel dispatches on the dimension once per particle chunk: 2D runs use the
-!> specialised loops of [[empm_transfer_2d]] (same arithmetic, same order, same bits), other
-!> dimensions the generic loops here. Nodal and particle arrays must be contiguous.
+!> The kernels of the time step (mass + momentum, internal force, G2P, velocity gradient)
+!> dispatch on the dimension once per particle chunk: 2D runs use the specialised loops of
+!> [[empm_transfer_2d]] (same arithmetic, same order, same bits), other dimensions the generic
+!> loops here; the less frequent transfers (p2g_mass, p2g_weighted, body forces) are generic
+!> only. Nodal and particle arrays must be contiguous.
 module empm_transfer
-  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   use empm_shape, only: empm_basis_t
   use empm_nodes, only: empm_nodes_t
-  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_max_threads
+  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_transfer_2d, only: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, &
                               g2p_2d, g2p_pc_newmark_2d
   implicit none
@@ -71,7 +72,7 @@ contains
     ! Chunk by chunk, each one's particles shared by all threads (a loop over the chunks
     ! would leave one thread alone with chunk 2 when there are two).
     do c = 2, self%nt
-      call chunk_bounds(basis%np, self%nt, c - 1, p0, p1)
+      call empm_chunk_bounds(basis%np, self%nt, c - 1, p0, p1)
       lo = huge(1); hi = 0
       !$omp parallel do num_threads(self%nt) schedule(static) private(k) &
       !$omp   reduction(min: lo) reduction(max: hi)
@@ -92,14 +93,6 @@ contains
     threaded = .false.
     if (present(ws)) threaded = ws%nt > 1
   end function threaded
-
-  !> Particles p0..p1 of chunk c (0-based) of n chunks over np particles.
-  pure subroutine chunk_bounds(np, n, c, p0, p1)
-    integer, intent(in) :: np, n, c
-    integer, intent(out) :: p0, p1
-    p0 = int(int(np, int64) * c / n) + 1
-    p1 = int(int(np, int64) * (c + 1) / n)
-  end subroutine chunk_bounds
 
   !> Add the chunk buffers to `q` (in chunk order) and zero them again.
   subroutine reduce_vec(ws, q)
@@ -148,7 +141,7 @@ contains
     !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
     !$omp do schedule(static, 1)
     do c = 1, ws%nt
-      call chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
+      call empm_chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
       if (c == 1) then
         call mass_range(basis, m, p0, p1, mass)
       else
@@ -190,7 +183,7 @@ contains
     !$omp parallel num_threads(ws%nt) default(shared) private(ic, p0, p1)
     !$omp do schedule(static, 1)
     do ic = 1, ws%nt
-      call chunk_bounds(basis%np, ws%nt, ic - 1, p0, p1)
+      call empm_chunk_bounds(basis%np, ws%nt, ic - 1, p0, p1)
       if (ic == 1) then
         call weighted_range(basis, m, u, c, w, p0, p1, q)
       else
@@ -242,7 +235,7 @@ contains
     !$omp parallel num_threads(ws%nt) default(shared) private(ic, p0, p1)
     !$omp do schedule(static, 1)
     do ic = 1, ws%nt
-      call chunk_bounds(basis%np, ws%nt, ic - 1, p0, p1)
+      call empm_chunk_bounds(basis%np, ws%nt, ic - 1, p0, p1)
       if (ic == 1) then
         call mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q)
       else
@@ -285,7 +278,7 @@ contains
     !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
     !$omp do schedule(static, 1)
     do c = 1, ws%nt
-      call chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
+      call empm_chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
       if (c == 1) then
         call internal_range(basis, vol, stress, p0, p1, f)
       else
@@ -348,7 +341,7 @@ contains
     !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
     !$omp do schedule(static, 1)
     do c = 1, ws%nt
-      call chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
+      call empm_chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
       if (c == 1) then
         call body_range(basis, m, g, b, use_b, p0, p1, f)
       else
@@ -380,23 +373,16 @@ contains
     end do
   end subroutine body_range
 
-  !> Particle chunks of a G2P pass: one per thread on large batches, else one.
-  integer function g2p_chunks(np) result(nc)
-    integer, intent(in) :: np
-    nc = 1
-    if (np >= EMPM_OMP_MIN_PARTICLES) nc = empm_max_threads()
-  end function g2p_chunks
-
   !> Interpolate a nodal vector to the particles: u_p = Σ_I N_Ip q_I.
   subroutine g2p_value(basis, q, u)
     type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
     real(wp), intent(in), contiguous :: q(:,:)       !! nodal vectors (ndim, nnode)
     real(wp), intent(out), contiguous :: u(:,:)      !! particle vectors (ndim, np)
     integer :: c, nc, p0, p1, p, k
-    nc = g2p_chunks(basis%np)
+    nc = empm_chunks(basis%np)
     !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k) if(nc > 1)
     do c = 0, nc - 1
-      call chunk_bounds(basis%np, nc, c, p0, p1)
+      call empm_chunk_bounds(basis%np, nc, c, p0, p1)
       if (basis%ndim == 2) then
         call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .false., 0.0_wp, u)
         cycle
@@ -420,10 +406,10 @@ contains
     real(wp) :: s(3)
     integer :: ic, nc, p0, p1, p, k, d
     d = basis%ndim
-    nc = g2p_chunks(basis%np)
+    nc = empm_chunks(basis%np)
     !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, s) if(nc > 1)
     do ic = 0, nc - 1
-      call chunk_bounds(basis%np, nc, ic, p0, p1)
+      call empm_chunk_bounds(basis%np, nc, ic, p0, p1)
       if (d == 2) then
         call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .true., c, u)
         cycle
@@ -455,10 +441,10 @@ contains
     real(wp) :: sv(3), sa(3)
     integer :: c, nc, p0, p1, p, k, I, d
     d = basis%ndim
-    nc = g2p_chunks(basis%np)
+    nc = empm_chunks(basis%np)
     !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, I, sv, sa) if(nc > 1)
     do c = 0, nc - 1
-      call chunk_bounds(basis%np, nc, c, p0, p1)
+      call empm_chunk_bounds(basis%np, nc, c, p0, p1)
       if (d == 2) then
         call g2p_pc_newmark_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, dt, g, &
                                vel, acc, x, v, a)
@@ -491,10 +477,10 @@ contains
     real(wp) :: g(3, 3)
     integer :: c, nc, p0, p1, p, k, I, a, b, d
     d = basis%ndim
-    nc = g2p_chunks(basis%np)
+    nc = empm_chunks(basis%np)
     !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, I, a, b, g) if(nc > 1)
     do c = 0, nc - 1
-      call chunk_bounds(basis%np, nc, c, p0, p1)
+      call empm_chunk_bounds(basis%np, nc, c, p0, p1)
       if (d == 2) then
         call velocity_gradient_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%dN, v, L)
         cycle
