@@ -29,7 +29,7 @@ program stability_curves
   character(len=:), allocatable :: outdir
   character(len=512) :: buf
   integer(hid_t) :: fid, g0, g1, g
-  integer :: i, k, info, ierr
+  integer :: i, k, info, ierr, e1, e2
 
   outdir = 'reports/integrators'
   if (command_argument_count() >= 1) then
@@ -95,9 +95,10 @@ program stability_curves
   end do
   call h5_close_group(g0, ierr)
   call h5_close_group(g1, ierr)
-  call h5fclose_f(fid, ierr)
-  call h5close_f(ierr)
-  if (ierr /= 0) error stop 'stability_curves: HDF5 error'
+  ! ierr has collected every write's status: the closes get their own, so none is lost.
+  call h5fclose_f(fid, e1)
+  call h5close_f(e2)
+  if (ierr /= 0 .or. e1 /= 0 .or. e2 /= 0) error stop 'stability_curves: HDF5 error'
   write(*, '(a)') 'wrote '//outdir//'/stability.h5'
 
 contains

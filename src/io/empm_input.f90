@@ -16,7 +16,7 @@ module empm_input
   use empm_shape, only: shape_status_text
   use empm_shape_factory, only: empm_shape_create, empm_shape_names, SHAPE_CREATE_BAD_PARAM
   use empm_shape_lme, only: empm_shape_lme_t, LME_REMEDY_NONE, LME_REMEDY_ENLARGE
-  use empm_material_factory, only: empm_material_create, material_status_text
+  use empm_material_factory, only: empm_material_create, material_status_text, MAT_UNKNOWN_NAME
   use empm_integrator_factory, only: empm_integrator_create, empm_integrator_names
   implicit none
   private
@@ -238,6 +238,10 @@ contains
     end if
     h = h / ov%refine; cells = cells * ov%refine
     call cs%model%grid%init(ndim, origin, h, cells, info)
+    if (info /= 0) then
+      ! Not reachable after the checks above; kept so that no grid error passes silently.
+      emsg = path//': group &grid: invalid grid (grid_init status '//str(info)//')'; return
+    end if
     call cs%model%pts%alloc(ndim, 1024)
   end subroutine read_grid
 
@@ -289,7 +293,7 @@ contains
       call move_alloc(tmp, cs%model%mats)
       cs%model%mats(n)%label = trim(name)
       call empm_material_create(trim(lower(model)), E, nu, density, cs%model%mats(n)%model, info)
-      if (info == 1) then
+      if (info == MAT_UNKNOWN_NAME) then
         emsg = req(path, 'material', 'model', 'unknown model '''//trim(model)//''': '// &
           material_status_text(info)); return
       else if (info /= 0) then
