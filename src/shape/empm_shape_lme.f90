@@ -520,13 +520,14 @@ contains
     if (info /= SHAPE_OK) nn = 0
   end subroutine lme_point
 
-  !> The common case in one lean pass: 2D, uniform γ, a warm start near λ*. The same
-  !> basis as [[lme_point]] (to round-off), with the work fused: one loop finds the candidates
-  !> (all active, since the box is filtered by γ|ξ|² ≤ −ln tol0) and their exponents, one
-  !> evaluates the weights and their moments up to third order (about the heaviest node),
-  !> one writes values and gradients. Newton stops as soon as the final linearised step is
-  !> provably within the tolerance (see [[lme_kernel]]); the moments of the linearised p̃ follow
-  !> from the third moments without another pass over the nodes. Only full Newton steps are
+  !> The common case, lean: 2D, uniform γ, a warm start near λ*. The same basis as
+  !> [[lme_point]] (to the Newton tolerance), with the work fused into three passes over the
+  !> support: one finds the candidates (all active, since the box is filtered by
+  !> γ|ξ|² ≤ −ln tol0) and their exponents, one evaluates the weights and their moments up to
+  !> third order (about the heaviest node), one writes values and gradients. Newton stops as
+  !> soon as a bound proves the residual after the final linearised step below the tolerance;
+  !> the moments of the final values follow from the third moments without another pass over
+  !> the nodes (docs/shape-functions.md, "The 2D batch path"). Only full Newton steps are
   !> taken here: whenever the general path could do something else (point outside the grid,
   !> ‖r‖ above the Armijo threshold, ill-conditioned J, a step or λ beyond its cap, the
   !> iteration cap, too few candidates or x outside their bounding box), `iters` returns
@@ -1212,8 +1213,9 @@ contains
     s = 0.0_wp; sr = 0.0_wp; sj = 0.0_wp; u = 0.0_wp
     c = 0.0_wp
     if (nd == 2 .and. .not. varying .and. nc <= MOM_BUF) then
-      ! The hot case, with scalars: the same expressions as the general loop below (same
-      ! results), without its short assumed-shape loops; the exponents are kept for the
+      ! The hot case, with scalars: the general loop's expressions, without its short
+      ! assumed-shape loops (same results, except sj(1, 2), summed here as Σ(e u1)u2 and
+      ! there as Σ(e u2)u1: they may differ in the last bit); the exponents are kept for the
       ! second pass rather than recomputed.
       do a = 1, nc
         if (w(a) < 0.0_wp) cycle

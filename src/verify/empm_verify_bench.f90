@@ -148,7 +148,7 @@ contains
     case ('mms_axis_aligned_2d')
       block
         type(empm_mms_axis_aligned_2d_t) :: m
-        self%uscale = m%A; self%vscale = m%A * pi * sqrt(m%E / m%rho0)
+        self%uscale = m%A; self%vscale = m%A * pi * sqrt(m%E / m%rho0) / m%L
         self%sscale = m%E * m%A * 2.0_wp * pi / m%L
         allocate(self%mms, source=m)
       end block
