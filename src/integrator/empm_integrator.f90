@@ -9,12 +9,16 @@ module empm_integrator
                         STEP_MATERIAL_FAILED
   use empm_transfer, only: p2g_mass, p2g_mass_momentum, p2g_internal_force, p2g_body_force, &
                            constrain_force, constrain_velocity, nodal_divide_by_mass, g2p_value, &
-                           empm_p2g_work_t
+                           velocity_gradient, empm_p2g_work_t
   use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID
   use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds, EMPM_OMP_MIN_PARTICLES
   implicit none
   private
   public :: empm_integrator_t, eval_basis, map_velocity, update_stress, initial_acceleration
+
+  !> Particles per material call in [[update_stress]]: their L, F, strain and stress fit in
+  !> the L1 cache together.
+  integer, parameter :: STRESS_BLOCK = 32
 
   !> Abstract explicit integrator. Work arrays are allocated once in `prepare`.
   type, abstract :: empm_integrator_t
@@ -162,28 +166,42 @@ contains
     call constrain_force(model%nodes, model%nodes%force)
   end subroutine assemble_forces
 
-  !> Stress update of every particle from its velocity gradient `pts%L`, one batched call per
-  !> run of particles sharing a material (with OpenMP, one call per thread on a slice of the
-  !> run: particles are independent); volumes follow from the updated densities.
-  subroutine update_stress(model, dt, stat)
+  !> Strain and stress update of every particle from the nodal velocities `vel`: per block of
+  !> STRESS_BLOCK particles, L_p = Σ v_I ⊗ ∇N_Ip into a small buffer, then one material call on
+  !> the block, then V_p = m_p/ρ_p. L stays in the cache instead of making a round trip through
+  !> memory. Blocks never straddle a run of particles sharing a material; with OpenMP each
+  !> thread takes a contiguous slice of every run (particles are independent, so the result does
+  !> not depend on the thread count). On failure `stat` names the first failing particle.
+  subroutine update_stress(model, vel, dt, stat)
     type(empm_model_t), intent(inout) :: model      !! simulation state
+    real(wp), intent(in), contiguous :: vel(:,:)    !! nodal velocities defining L (ndim, nnode)
     real(wp), intent(in) :: dt                      !! time step [s]
     type(empm_step_status_t), intent(inout) :: stat !! set on failure
-    integer :: r, i0, i1, info, im, n, nc, c, a, b, bad, p
+    real(wp) :: Lb(3, 3, STRESS_BLOCK)
+    integer :: r, i0, i1, info, im, n, nc, c, a, b, q0, q1, bad, p
     do r = 1, size(model%run_first)
       i0 = model%run_first(r); i1 = model%run_last(r)
       im = model%pts%mat(i0)
       n = i1 - i0 + 1
       nc = empm_chunks(n)
-      ! The first failing particle of the run, whichever slice it is in.
+      ! The first failing particle of the run, whichever block it is in.
       bad = huge(1)
-      !$omp parallel do schedule(static, 1) private(a, b, info) reduction(min: bad) if(nc > 1)
+      !$omp parallel do schedule(static, 1) private(a, b, q0, q1, p, Lb, info) &
+      !$omp& reduction(min: bad) if(nc > 1)
       do c = 0, nc - 1
         call empm_chunk_bounds(n, nc, c, a, b)
         a = a + i0 - 1; b = b + i0 - 1
-        call model%mats(im)%model%update(dt, model%pts%L(:, :, a:b), model%pts%F(:, :, a:b), &
-          model%pts%strain(:, a:b), model%pts%stress(:, a:b), model%pts%rho(a:b), info)
-        if (info /= 0) bad = min(bad, a + info - 1)
+        Lb = 0.0_wp ! the blocks write only the ndim×ndim part
+        do q0 = a, b, STRESS_BLOCK
+          q1 = min(b, q0 + STRESS_BLOCK - 1)
+          call velocity_gradient(model%basis, vel, q0, q1, Lb)
+          call model%mats(im)%model%update(dt, Lb(:, :, 1:q1 - q0 + 1), model%pts%F(:, :, q0:q1), &
+            model%pts%strain(:, q0:q1), model%pts%stress(:, q0:q1), model%pts%rho(q0:q1), info)
+          if (info /= 0) bad = min(bad, q0 + info - 1)
+          do p = q0, q1
+            model%pts%vol(p) = model%pts%m(p) / model%pts%rho(p)
+          end do
+        end do
       end do
       !$omp end parallel do
       if (bad /= huge(1)) then
@@ -191,11 +209,5 @@ contains
         return
       end if
     end do
-    n = model%pts%np
-    !$omp parallel do schedule(static) if(n >= EMPM_OMP_MIN_PARTICLES)
-    do p = 1, n
-      model%pts%vol(p) = model%pts%m(p) / model%pts%rho(p)
-    end do
-    !$omp end parallel do
   end subroutine update_stress
 end module empm_integrator

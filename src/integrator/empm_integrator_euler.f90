@@ -13,7 +13,7 @@ module empm_integrator_euler
   use empm_integrator, only: empm_integrator_t, map_velocity, update_stress
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: p2g_weighted, g2p_add_scaled, g2p_value, &
-                           velocity_gradient, nodal_divide_by_mass, constrain_velocity
+                           nodal_divide_by_mass, constrain_velocity
   use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
@@ -55,8 +55,7 @@ contains
       if (stat%code /= STEP_OK) return
 
       if (self%variant == EULER_USF) then
-        call velocity_gradient(basis, nodes%vel, pts%L)
-        call update_stress(model, dt, stat)
+        call update_stress(model, nodes%vel, dt, stat)
         call tm%lap(PHASE_STRESS)
         if (stat%code /= STEP_OK) return
       end if
@@ -77,8 +76,7 @@ contains
 
       select case (self%variant)
       case (EULER_USL)
-        call velocity_gradient(basis, nodes%vel, pts%L)
-        call update_stress(model, dt, stat)
+        call update_stress(model, nodes%vel, dt, stat)
         call tm%lap(PHASE_STRESS)
       case (EULER_MUSL)
         ! Re-map momentum from the updated particle velocities (Sulsky's MUSL).
@@ -88,8 +86,7 @@ contains
         call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
         call constrain_velocity(nodes, nodes%vel, nodes%mom)
         call tm%lap(PHASE_GRID)
-        call velocity_gradient(basis, nodes%vel, pts%L)
-        call update_stress(model, dt, stat)
+        call update_stress(model, nodes%vel, dt, stat)
         call tm%lap(PHASE_STRESS)
       end select
     end associate

@@ -13,7 +13,7 @@ module empm_integrator_genalpha
   use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: p2g_weighted, g2p_add_scaled, g2p_value, &
-                           velocity_gradient, nodal_divide_by_mass, &
+                           nodal_divide_by_mass, &
                            constrain_force
   use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
@@ -92,8 +92,7 @@ contains
       call tm%lap(PHASE_G2P)
       ! Strain with the nodal displacement actually applied: L = Σ (Δu_I/Δt) ⊗ ∇N.
       nodes%force = nodes%force / dt
-      call velocity_gradient(basis, nodes%force, pts%L)
-      call update_stress(model, dt, stat)
+      call update_stress(model, nodes%force, dt, stat)
       call tm%lap(PHASE_STRESS)
     end associate
   end subroutine ga_step

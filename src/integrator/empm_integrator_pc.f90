@@ -16,7 +16,7 @@ module empm_integrator_pc
   use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: g2p_add_scaled, g2p_value, g2p_pc_newmark, &
-                           velocity_gradient, nodal_divide_by_mass
+                           nodal_divide_by_mass
   use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
@@ -68,8 +68,7 @@ contains
       call map_velocity(self, model, stat, (1.0_wp - g) * dt, pts%a)
       if (stat%code /= STEP_OK) return
       ! Strain increment and stress with the predicted velocity.
-      call velocity_gradient(basis, nodes%vel, pts%L)
-      call update_stress(model, dt, stat)
+      call update_stress(model, nodes%vel, dt, stat)
       call tm%lap(PHASE_STRESS)
       if (stat%code /= STEP_OK) return
       ! Balance of forces at t + Δt; nodes%acc = f/m (zero on fixed dofs).

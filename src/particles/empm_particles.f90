@@ -24,7 +24,6 @@ module empm_particles
     real(wp), allocatable :: strain(:,:)    !! accumulated small strain, Voigt (6, np)
     real(wp), allocatable :: F(:,:,:)       !! deformation gradient (3, 3, np): finite-strain
                                             !! models (small-strain ones leave it = I)
-    real(wp), allocatable :: L(:,:,:)       !! velocity gradient of the last step (3, 3, np) [1/s]
     real(wp), allocatable :: lp(:,:)        !! half-length of the particle domain (ndim, np) [m]
     real(wp), allocatable :: lam(:,:)       !! shape-function state (LME Lagrange multiplier) (ndim, np)
     real(wp), allocatable :: lam_old(:,:)   !! its value one evaluation earlier (LME extrapolation;
@@ -48,10 +47,10 @@ contains
     self%ndim = ndim
     self%np = 0
     if (allocated(self%x)) deallocate(self%x, self%x0, self%v, self%a, self%m, self%vol, self%vol0, &
-      self%rho, self%stress, self%strain, self%F, self%L, self%lp, self%lam, self%lam_old, self%mat)
+      self%rho, self%stress, self%strain, self%F, self%lp, self%lam, self%lam_old, self%mat)
     allocate(self%x(ndim, n), self%x0(ndim, n), self%v(ndim, n), self%a(ndim, n), &
       self%m(n), self%vol(n), self%vol0(n), self%rho(n), self%stress(6, n), self%strain(6, n), &
-      self%F(3, 3, n), self%L(3, 3, n), self%lp(ndim, n), self%lam(ndim, n), &
+      self%F(3, 3, n), self%lp(ndim, n), self%lam(ndim, n), &
       self%lam_old(ndim, n), self%mat(n))
   end subroutine particles_alloc
 
@@ -81,7 +80,6 @@ contains
     self%stress(:, n) = 0.0_wp; self%strain(:, n) = 0.0_wp
     self%F(:, :, n) = 0.0_wp; self%F(1, 1, n) = 1.0_wp; self%F(2, 2, n) = 1.0_wp
     self%F(3, 3, n) = 1.0_wp
-    self%L(:, :, n) = 0.0_wp
     ! lam_old = huge: no history yet (see the LME warm-start extrapolation).
     self%lp(:, n) = lp(1:d); self%lam(:, n) = 0.0_wp; self%lam_old(:, n) = huge(1.0_wp)
     self%mat(n) = mat
@@ -99,7 +97,7 @@ contains
     self%m(1:n) = src%m(1:n); self%vol(1:n) = src%vol(1:n); self%vol0(1:n) = src%vol0(1:n)
     self%rho(1:n) = src%rho(1:n)
     self%stress(:, 1:n) = src%stress(:, 1:n); self%strain(:, 1:n) = src%strain(:, 1:n)
-    self%F(:, :, 1:n) = src%F(:, :, 1:n); self%L(:, :, 1:n) = src%L(:, :, 1:n)
+    self%F(:, :, 1:n) = src%F(:, :, 1:n)
     self%lp(:, 1:n) = src%lp(:, 1:n); self%lam(:, 1:n) = src%lam(:, 1:n)
     self%lam_old(:, 1:n) = src%lam_old(:, 1:n)
     self%mat(1:n) = src%mat(1:n)
@@ -114,7 +112,7 @@ contains
     call move_alloc(from%m, to%m); call move_alloc(from%vol, to%vol)
     call move_alloc(from%vol0, to%vol0); call move_alloc(from%rho, to%rho)
     call move_alloc(from%stress, to%stress); call move_alloc(from%strain, to%strain)
-    call move_alloc(from%F, to%F); call move_alloc(from%L, to%L)
+    call move_alloc(from%F, to%F)
     call move_alloc(from%lp, to%lp); call move_alloc(from%lam, to%lam)
     call move_alloc(from%lam_old, to%lam_old)
     call move_alloc(from%mat, to%mat)

@@ -467,39 +467,39 @@ contains
     !$omp end parallel do
   end subroutine g2p_pc_newmark
 
-  !> Velocity gradient L_p = Σ_I v_I ⊗ ∇N_Ip, embedded in 3×3 (zeros in unused directions).
-  subroutine velocity_gradient(basis, v, L)
-    type(empm_basis_t), intent(in) :: basis           !! shape functions at the particles
-    real(wp), intent(in), contiguous :: v(:,:)        !! nodal velocities (ndim, nnode)
-    real(wp), intent(inout), contiguous :: L(:,:,:)   !! velocity gradients (3, 3, np); only the
-                                                      !! ndim×ndim block is written (the rest
-                                                      !! stays 0 from set-up)
+  !> Velocity gradients L_p = Σ_I v_I ⊗ ∇N_Ip of particles p0..p1, into L(:, :, 1:p1-p0+1).
+  !> Serial, for one block of particles inside a particle-parallel loop (the stress update
+  !> calls it block by block, so L never leaves the cache). Only the ndim×ndim block of each
+  !> L is written: zero `L` once before the first call.
+  pure subroutine velocity_gradient(basis, v, p0, p1, L)
+    type(empm_basis_t), intent(in) :: basis         !! shape functions at the particles
+    real(wp), intent(in), contiguous :: v(:,:)      !! nodal velocities (ndim, nnode)
+    integer, intent(in) :: p0                       !! first particle
+    integer, intent(in) :: p1                       !! last particle (p1 < p0: nothing to do)
+    real(wp), intent(inout), contiguous :: L(:,:,:) !! velocity gradients (3, 3, >= p1-p0+1)
     real(wp) :: g(3, 3)
-    integer :: c, nc, p0, p1, p, k, I, a, b, d
+    integer :: p, k, I, a, b, d
     d = basis%ndim
-    nc = empm_chunks(basis%np)
-    !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, I, a, b, g) if(nc > 1)
-    do c = 0, nc - 1
-      call empm_chunk_bounds(basis%np, nc, c, p0, p1)
-      if (d == 2) then
-        call velocity_gradient_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%dN, v, L)
-        cycle
-      end if
-      do p = p0, p1
-        ! Accumulate in registers, store once: fewer writes to the particle array.
-        g = 0.0_wp
-        do k = 1, basis%nn(p)
-          I = basis%node(k, p)
-          do b = 1, d
-            do a = 1, d
-              g(a, b) = g(a, b) + v(a, I) * basis%dN(b, k, p)
-            end do
+    if (p1 < p0) return
+    if (d == 2) then
+      ! Element sequence association: the kernel sees particles p0..p1 as 1..p1-p0+1.
+      call velocity_gradient_2d(basis%maxn, 1, p1 - p0 + 1, basis%nn(p0), basis%node(1, p0), &
+                                basis%dN(1, 1, p0), v, L)
+      return
+    end if
+    do p = p0, p1
+      ! Accumulate in registers, store once.
+      g = 0.0_wp
+      do k = 1, basis%nn(p)
+        I = basis%node(k, p)
+        do b = 1, d
+          do a = 1, d
+            g(a, b) = g(a, b) + v(a, I) * basis%dN(b, k, p)
           end do
         end do
-        L(1:d, 1:d, p) = g(1:d, 1:d)
       end do
+      L(1:d, 1:d, p - p0 + 1) = g(1:d, 1:d)
     end do
-    !$omp end parallel do
   end subroutine velocity_gradient
 
   !> out_I = q_I / m_I on nodes with mass above the empty-node threshold, 0 elsewhere.
