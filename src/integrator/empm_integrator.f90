@@ -205,7 +205,7 @@ contains
       end do
       !$omp end parallel do
       if (bad /= huge(1)) then
-        stat%code = STEP_MATERIAL_FAILED; stat%detail = bad - i0 + 1; stat%particle = bad
+        stat%code = STEP_MATERIAL_FAILED; stat%detail = im; stat%particle = bad
         return
       end if
     end do

@@ -26,7 +26,7 @@ module empm_model
   !> Outcome of one time step.
   type :: empm_step_status_t
     integer :: code = STEP_OK   !! STEP_* code
-    integer :: detail = 0       !! SHAPE_* or material status
+    integer :: detail = 0       !! SHAPE_* code, or the failing particle's material index
     integer :: particle = 0     !! offending particle, 0 if none
   end type empm_step_status_t
 

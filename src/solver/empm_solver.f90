@@ -196,8 +196,8 @@ contains
           ' left the grid: x = '//vec(model%pts%x(:, p))
       else
         text = 'step '//str(model%step)//': stress update failed at particle '// &
-          str(s%particle)//' (material status '//str(s%detail)// &
-          ', e.g. det F <= 0: the particle is inverted)'
+          str(s%particle)//' (material '//str(s%detail)// &
+          '): its volume ratio became <= 0 (e.g. det F <= 0: the particle is inverted)'
       end if
     end function describe_status
   end subroutine empm_solve
