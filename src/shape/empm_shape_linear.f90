@@ -17,6 +17,7 @@ module empm_shape_linear
   private
   public :: empm_shape_linear_t, shape_linear_kernel
   public :: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, shape_batch_fits
+  public :: shape_keep_first_failure
 
   !> Most nodes per direction of any tensor-product family (cubic B-spline).
   integer, parameter :: SHAPE_TP_MAXM = 4
@@ -107,13 +108,7 @@ contains
     do p = 1, pts%np
       call shape_linear_kernel(grid, pts%x(:, p), basis%nn(p), basis%node(:, p), &
                                basis%N(:, p), basis%dN(:, :, p), pinfo)
-      if (pinfo /= SHAPE_OK) then
-        !$omp critical (empm_shape_failure)
-        if (p < ibad) then
-          ibad = p; info = pinfo
-        end if
-        !$omp end critical (empm_shape_failure)
-      end if
+      if (pinfo /= SHAPE_OK) call shape_keep_first_failure(p, pinfo, ibad, info)
     end do
     !$omp end parallel do
     if (ibad == huge(1)) ibad = 0
@@ -297,4 +292,18 @@ contains
     end if
     if (ibad /= 0) info = SHAPE_TOO_MANY_NODES
   end subroutine shape_batch_fits
+
+  !> In a particle-parallel batch loop, after particle `p` failed with `pinfo`: keep the lowest
+  !> failing particle and its code, as a serial loop would report. `ibad` starts at huge(1).
+  subroutine shape_keep_first_failure(p, pinfo, ibad, info)
+    integer, intent(in) :: p         !! the failing particle
+    integer, intent(in) :: pinfo     !! its SHAPE_* code
+    integer, intent(inout) :: ibad   !! lowest failing particle so far (shared by the threads)
+    integer, intent(inout) :: info   !! its code (shared by the threads)
+    !$omp critical (empm_shape_failure)
+    if (p < ibad) then
+      ibad = p; info = pinfo
+    end if
+    !$omp end critical (empm_shape_failure)
+  end subroutine shape_keep_first_failure
 end module empm_shape_linear

@@ -92,7 +92,7 @@ module empm_shape_lme
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_NOT_CONVERGED, SHAPE_OUTSIDE_HULL, &
                         SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES
-  use empm_shape_linear, only: shape_batch_fits
+  use empm_shape_linear, only: shape_batch_fits, shape_keep_first_failure
   implicit none
   private
   public :: empm_shape_lme_t, lme_kernel, lme_support_radius, lme_format_gamma
@@ -397,13 +397,7 @@ contains
         pts%lam(:, p) = lam(1:nd)
       end if
       iters = iters + it
-      if (pinfo /= SHAPE_OK) then
-        !$omp critical (empm_shape_failure)
-        if (p < ibad) then
-          ibad = p; info = pinfo
-        end if
-        !$omp end critical (empm_shape_failure)
-      end if
+      if (pinfo /= SHAPE_OK) call shape_keep_first_failure(p, pinfo, ibad, info)
     end do
     !$omp end parallel do
     if (ibad == huge(1)) ibad = 0

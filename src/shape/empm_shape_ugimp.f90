@@ -27,7 +27,7 @@ module empm_shape_ugimp
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES
   use empm_shape_linear, only: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, &
-                               shape_batch_fits
+                               shape_batch_fits, shape_keep_first_failure
   implicit none
   private
   public :: empm_shape_ugimp_t, shape_ugimp_kernel
@@ -96,13 +96,7 @@ contains
     do p = 1, pts%np
       call shape_ugimp_kernel(grid, pts%x(:, p), pts%lp(:, p), basis%nn(p), basis%node(:, p), &
                               basis%N(:, p), basis%dN(:, :, p), pinfo)
-      if (pinfo /= SHAPE_OK) then
-        !$omp critical (empm_shape_failure)
-        if (p < ibad) then
-          ibad = p; info = pinfo
-        end if
-        !$omp end critical (empm_shape_failure)
-      end if
+      if (pinfo /= SHAPE_OK) call shape_keep_first_failure(p, pinfo, ibad, info)
     end do
     !$omp end parallel do
     if (ibad == huge(1)) ibad = 0
