@@ -11,7 +11,7 @@ module empm_integrator
                            constrain_force, constrain_velocity, nodal_divide_by_mass, g2p_value, &
                            velocity_gradient, empm_p2g_work_t
   use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID
-  use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds, EMPM_OMP_MIN_PARTICLES
+  use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds
   implicit none
   private
   public :: empm_integrator_t, eval_basis, map_velocity, update_stress, initial_acceleration
