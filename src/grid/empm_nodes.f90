@@ -19,10 +19,15 @@ module empm_nodes
     real(wp), allocatable :: work(:,:)      !! scratch nodal vector (ndim, nnode)
     logical, allocatable :: fixed(:,:)      !! Dirichlet mask per dof (ndim, nnode)
     real(wp), allocatable :: vfix(:,:)      !! prescribed velocity on fixed dofs (ndim, nnode) [m/s]
+    integer, allocatable :: fixed_dofs(:)   !! the fixed dofs as positions d + ndim (I − 1) in
+                                            !! the (ndim, nnode) arrays, increasing; derived
+                                            !! from `fixed` by `list_fixed` (fix_box and the
+                                            !! model's set-up call it)
   contains
     procedure :: alloc => nodes_alloc
     procedure :: reset => nodes_reset
     procedure :: fix_box => nodes_fix_box
+    procedure :: list_fixed => nodes_list_fixed
   end type empm_nodes_t
 
 contains
@@ -39,6 +44,7 @@ contains
     allocate(self%mass(n), self%mom(d, n), self%vel(d, n), self%force(d, n), self%acc(d, n), &
       self%work(d, n), self%fixed(d, n), self%vfix(d, n))
     self%fixed = .false.; self%vfix = 0.0_wp
+    call self%list_fixed()
     call zero(self%mass, n); call zero(self%mom, d * n); call zero(self%vel, d * n)
     call zero(self%force, d * n); call zero(self%acc, d * n); call zero(self%work, d * n)
   end subroutine nodes_alloc
@@ -96,5 +102,20 @@ contains
         end do
       end if
     end do
+    call self%list_fixed()
   end subroutine nodes_fix_box
+
+  !> Rebuild `fixed_dofs` from `fixed`, so that the constraint passes of every step visit the
+  !> fixed dofs only (none, usually, or a boundary's worth) instead of every node. Call after
+  !> changing `fixed` directly; [[nodes_fix_box]] and the model's set-up call it.
+  subroutine nodes_list_fixed(self)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields
+    integer :: k
+    if (allocated(self%fixed_dofs)) deallocate(self%fixed_dofs)
+    if (.not. allocated(self%fixed)) then
+      allocate(self%fixed_dofs(0)); return
+    end if
+    allocate(self%fixed_dofs(count(self%fixed)))
+    self%fixed_dofs = pack([(k, k = 1, size(self%fixed))], reshape(self%fixed, [size(self%fixed)]))
+  end subroutine nodes_list_fixed
 end module empm_nodes

@@ -86,11 +86,11 @@ contains
   pure subroutine le_update(self, dt, L, F, strain, stress, rho, info)
     class(empm_linear_elastic_t), intent(in) :: self !! material
     real(wp), intent(in) :: dt                       !! time step [s]
-    real(wp), intent(in) :: L(:,:,:)                 !! velocity gradient (3,3,n) [1/s]
-    real(wp), intent(inout) :: F(:,:,:)              !! deformation gradient (3,3,n), left unchanged
-    real(wp), intent(inout) :: strain(:,:)           !! small strain, Voigt (6,n)
-    real(wp), intent(inout) :: stress(:,:)           !! Cauchy stress, Voigt (6,n) [Pa]
-    real(wp), intent(inout) :: rho(:)                !! density (n) [kg/m³]
+    real(wp), intent(in), contiguous :: L(:,:,:)           !! velocity gradient (3,3,n) [1/s]
+    real(wp), intent(inout), contiguous :: F(:,:,:)        !! deformation gradient (3,3,n), left unchanged
+    real(wp), intent(inout), contiguous :: strain(:,:)     !! small strain, Voigt (6,n)
+    real(wp), intent(inout), contiguous :: stress(:,:)     !! Cauchy stress, Voigt (6,n) [Pa]
+    real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
     integer, intent(out) :: info                     !! 0 ok; k > 0 particle k failed; −1 shapes
     real(wp) :: de(6), tr
     integer :: p, n

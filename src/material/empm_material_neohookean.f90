@@ -42,10 +42,10 @@ contains
     real(wp), intent(in) :: lambda    !! Lamé λ [Pa]
     real(wp), intent(in) :: F(3,3)    !! deformation gradient, det F > 0
     real(wp) :: sigma(3,3)            !! Cauchy stress [Pa]
-    real(wp) :: J
+    real(wp) :: J, eye(3,3)
     J = det3(F)
-    sigma = (mu / J) * (matmul(F, transpose(F)) - identity3()) &
-          + (lambda * log(J) / J) * identity3()
+    eye = identity3() ! a local: gfortran -O3 warns about the inlined function results
+    sigma = (mu / J) * (matmul(F, transpose(F)) - eye) + (lambda * log(J) / J) * eye
   end function empm_neohookean_cauchy
 
   !> Stored energy ψ₀ = μ/2 (tr(FᵀF) − 3) − μ ln J + λ/2 (ln J)² per *reference* volume.
@@ -81,11 +81,11 @@ contains
   pure subroutine nh_update(self, dt, L, F, strain, stress, rho, info)
     class(empm_neohookean_t), intent(in) :: self !! material
     real(wp), intent(in) :: dt                   !! time step [s]
-    real(wp), intent(in) :: L(:,:,:)             !! velocity gradient (3,3,n) [1/s]
-    real(wp), intent(inout) :: F(:,:,:)          !! deformation gradient (3,3,n)
-    real(wp), intent(inout) :: strain(:,:)       !! sym(F) − I on output, Voigt (6,n)
-    real(wp), intent(inout) :: stress(:,:)       !! Cauchy stress, Voigt (6,n) [Pa]
-    real(wp), intent(inout) :: rho(:)            !! density (n) [kg/m³]
+    real(wp), intent(in), contiguous :: L(:,:,:)           !! velocity gradient (3,3,n) [1/s]
+    real(wp), intent(inout), contiguous :: F(:,:,:)        !! deformation gradient (3,3,n)
+    real(wp), intent(inout), contiguous :: strain(:,:)     !! sym(F) − I on output, Voigt (6,n)
+    real(wp), intent(inout), contiguous :: stress(:,:)     !! Cauchy stress, Voigt (6,n) [Pa]
+    real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
     integer, intent(out) :: info                 !! 0 ok; k > 0 particle k failed; −1 shapes
     real(wp) :: eye(3,3), Fn(3,3), J0, J1
     integer :: p, n

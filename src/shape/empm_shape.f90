@@ -11,9 +11,10 @@ module empm_shape
   use empm_particles, only: empm_particles_t
   implicit none
   private
-  public :: empm_shape_t, empm_basis_t
+  public :: empm_shape_t, empm_basis_t, BASIS_LISTS, BASIS_Q4, basis_q4_weights
   public :: SHAPE_OK, SHAPE_OUTSIDE_GRID, SHAPE_SUPPORT_CLIPPED, SHAPE_NOT_CONVERGED, &
-            SHAPE_OUTSIDE_HULL, SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES, shape_status_text
+            SHAPE_OUTSIDE_HULL, SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
+            shape_status_text
 
   integer, parameter :: SHAPE_OK = 0              !! evaluation succeeded
   integer, parameter :: SHAPE_OUTSIDE_GRID = 1    !! the point lies outside the grid box
@@ -22,18 +23,38 @@ module empm_shape
   integer, parameter :: SHAPE_OUTSIDE_HULL = 4    !! point outside the convex hull of its nodes
   integer, parameter :: SHAPE_SINGULAR = 5        !! singular or ill-conditioned system
   integer, parameter :: SHAPE_TOO_MANY_NODES = 6  !! support larger than the storage provided
+  integer, parameter :: SHAPE_BAD_LAYOUT = 7      !! basis storage layout this family cannot fill
 
-  !> Shape-function values and gradients for every particle (contiguous per particle).
+  integer, parameter :: BASIS_LISTS = 0 !! layout: node lists with values and gradients (any family)
+  integer, parameter :: BASIS_Q4 = 1    !! layout: bilinear on a 2D grid, the cell and two local
+                                        !! coordinates per particle (values recomputed when used)
+
+  !> Shape-function values and gradients for every particle, in one of two layouts.
+  !>
+  !> `BASIS_LISTS` (any family): per particle the number of supporting nodes, their indices,
+  !> values and gradients, contiguous per particle. `BASIS_Q4` (linear shapes on a 2D grid,
+  !> chosen by the family through [[empm_shape_t(type):layout]]): per particle only the lowest
+  !> node of its cell and the local coordinates (t1, t2) in [0, 1]; the four nodes are
+  !> cell, cell + 1, cell + stride, cell + stride + 1 and the values and gradients are the
+  !> bilinear ones of [[basis_q4_weights]], recomputed by every transfer (20 B per particle
+  !> instead of 116 B, read four times a step). Either way, [[basis_get]] gives one particle's
+  !> nodes, values and gradients, the same bits as the transfers use.
   type :: empm_basis_t
+    integer :: layout = BASIS_LISTS         !! BASIS_LISTS or BASIS_Q4
     integer :: ndim = 0                     !! spatial dimension
     integer :: maxn = 0                     !! capacity: nodes per particle
     integer :: np = 0                       !! number of particles
-    integer, allocatable :: nn(:)           !! nodes in the support of each particle (np)
-    integer, allocatable :: node(:,:)       !! node indices (maxn, np)
-    real(wp), allocatable :: N(:,:)         !! values N_Ip (maxn, np)
-    real(wp), allocatable :: dN(:,:,:)      !! gradients ∇N_Ip (ndim, maxn, np)
+    integer, allocatable :: nn(:)           !! lists: nodes in the support of each particle (np)
+    integer, allocatable :: node(:,:)       !! lists: node indices (maxn, np)
+    real(wp), allocatable :: N(:,:)         !! lists: values N_Ip (maxn, np)
+    real(wp), allocatable :: dN(:,:,:)      !! lists: gradients ∇N_Ip (ndim, maxn, np)
+    integer, allocatable :: cell(:)         !! Q4: lowest node of the particle's cell (np)
+    real(wp), allocatable :: t(:,:)         !! Q4: local coordinates in the cell, in [0, 1] (2, np)
+    integer :: stride = 0                   !! Q4: nodes along x (set by the family's batch)
+    real(wp) :: inv_h(2) = 1.0_wp           !! Q4: 1/h per direction (set by the family's batch)
   contains
     procedure :: alloc => basis_alloc
+    procedure :: get => basis_get
   end type empm_basis_t
 
   !> Abstract shape-function family.
@@ -45,6 +66,7 @@ module empm_shape
     procedure(eval_batch_iface), deferred :: eval_batch
     procedure(name_iface), deferred :: name
     procedure :: eval_batch_iters => shape_eval_batch_iters
+    procedure :: layout => shape_layout
   end type empm_shape_t
 
   abstract interface
@@ -106,17 +128,88 @@ contains
     iters = 0
   end subroutine shape_eval_batch_iters
 
-  !> Allocate basis storage for `np` particles with up to `maxn` nodes each.
-  subroutine basis_alloc(self, ndim, maxn, np)
+  !> Basis layout the family fills fastest on `grid`; the default is BASIS_LISTS, the only
+  !> layout every family fills. A family overriding it must fill that layout in `eval_batch`.
+  pure integer function shape_layout(self, grid)
+    class(empm_shape_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid   !! background grid
+    associate (unused_ => self, unused_grid_ => grid); end associate
+    shape_layout = BASIS_LISTS
+  end function shape_layout
+
+  !> Allocate basis storage for `np` particles with up to `maxn` nodes each, in `layout`
+  !> (default BASIS_LISTS; BASIS_Q4 needs ndim = 2 and maxn >= 4, otherwise lists are used).
+  subroutine basis_alloc(self, ndim, maxn, np, layout)
     class(empm_basis_t), intent(inout) :: self !! basis storage
     integer, intent(in) :: ndim                !! spatial dimension
     integer, intent(in) :: maxn                !! nodes per particle (capacity)
     integer, intent(in) :: np                  !! number of particles
+    integer, intent(in), optional :: layout    !! BASIS_LISTS (default) or BASIS_Q4
     if (allocated(self%nn)) deallocate(self%nn, self%node, self%N, self%dN)
+    if (allocated(self%cell)) deallocate(self%cell, self%t)
     self%ndim = ndim; self%maxn = maxn; self%np = np
-    allocate(self%nn(np), self%node(maxn, np), self%N(maxn, np), self%dN(ndim, maxn, np))
-    self%nn = 0; self%node = 1; self%N = 0.0_wp; self%dN = 0.0_wp
+    self%layout = BASIS_LISTS
+    if (present(layout)) then
+      if (layout == BASIS_Q4 .and. ndim == 2 .and. maxn >= 4) self%layout = BASIS_Q4
+    end if
+    if (self%layout == BASIS_Q4) then
+      allocate(self%cell(np), self%t(2, np))
+      self%cell = 1; self%t = 0.0_wp
+      self%stride = 0; self%inv_h = 1.0_wp
+    else
+      allocate(self%nn(np), self%node(maxn, np), self%N(maxn, np), self%dN(ndim, maxn, np))
+      self%nn = 0; self%node = 1; self%N = 0.0_wp; self%dN = 0.0_wp
+    end if
   end subroutine basis_alloc
+
+  !> Nodes, values and gradients of particle `p`, whatever the layout (for tests, output and
+  !> embedding codes; the transfers read the storage directly). `node`, `N` and `dN` need room
+  !> for `maxn` nodes; `nn` = 0 when `p` is out of range or the storage too small.
+  pure subroutine basis_get(self, p, nn, node, N, dN)
+    class(empm_basis_t), intent(in) :: self !! basis storage
+    integer, intent(in) :: p                !! particle, 1..np
+    integer, intent(out) :: nn              !! number of supporting nodes
+    integer, intent(out) :: node(:)         !! node indices
+    real(wp), intent(out) :: N(:)           !! values
+    real(wp), intent(out) :: dN(:,:)        !! gradients (ndim, :)
+    integer :: id
+    nn = 0
+    if (p < 1 .or. p > self%np) return
+    if (self%layout == BASIS_Q4) then
+      if (size(node) < 4 .or. size(N) < 4 .or. size(dN, 1) < 2 .or. size(dN, 2) < 4) return
+      id = self%cell(p)
+      node(1:4) = [id, id + 1, id + self%stride, id + self%stride + 1]
+      call basis_q4_weights(self%t(1, p), self%t(2, p), self%inv_h(1), self%inv_h(2), &
+                            N(1:4), dN(1:2, 1:4))
+      nn = 4
+    else
+      if (size(node) < self%nn(p) .or. size(N) < self%nn(p) .or. size(dN, 1) < self%ndim &
+          .or. size(dN, 2) < self%nn(p)) return
+      nn = self%nn(p)
+      node(1:nn) = self%node(1:nn, p)
+      N(1:nn) = self%N(1:nn, p)
+      dN(1:self%ndim, 1:nn) = self%dN(:, 1:nn, p)
+    end if
+  end subroutine basis_get
+
+  !> Bilinear values and gradients from the local coordinates (t1, t2) of a cell with 1/h =
+  !> (h1, h2); nodes in increasing index order (x fastest). The one definition of the Q4
+  !> basis: the linear family's 2D kernel and the Q4 transfers use these expressions.
+  pure subroutine basis_q4_weights(t1, t2, h1, h2, N, dN)
+    real(wp), intent(in) :: t1        !! local coordinate along x, in [0, 1]
+    real(wp), intent(in) :: t2        !! local coordinate along y, in [0, 1]
+    real(wp), intent(in) :: h1        !! 1/h along x
+    real(wp), intent(in) :: h2        !! 1/h along y
+    real(wp), intent(out) :: N(4)     !! values
+    real(wp), intent(out) :: dN(2, 4) !! gradients
+    real(wp) :: u1, u2
+    u1 = 1.0_wp - t1; u2 = 1.0_wp - t2
+    N(1) = u1 * u2; N(2) = t1 * u2; N(3) = u1 * t2; N(4) = t1 * t2
+    dN(1, 1) = -h1 * u2; dN(2, 1) = -u1 * h2
+    dN(1, 2) = h1 * u2;  dN(2, 2) = -t1 * h2
+    dN(1, 3) = -h1 * t2; dN(2, 3) = u1 * h2
+    dN(1, 4) = h1 * t2;  dN(2, 4) = t1 * h2
+  end subroutine basis_q4_weights
 
   !> Human-readable text for a SHAPE_* status code.
   pure function shape_status_text(info) result(s)
@@ -130,6 +223,7 @@ contains
     case (SHAPE_OUTSIDE_HULL);    s = 'point outside the convex hull of its support nodes'
     case (SHAPE_SINGULAR);        s = 'singular or ill-conditioned system'
     case (SHAPE_TOO_MANY_NODES);  s = 'support larger than the storage provided'
+    case (SHAPE_BAD_LAYOUT);      s = 'basis storage layout this shape family cannot fill'
     case default;                 s = 'unknown shape-function status'
     end select
   end function shape_status_text

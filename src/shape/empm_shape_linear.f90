@@ -12,7 +12,8 @@ module empm_shape_linear
   use empm_particles, only: empm_particles_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
-                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES
+                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
+                        BASIS_LISTS, BASIS_Q4, basis_q4_weights
   implicit none
   private
   public :: empm_shape_linear_t, shape_linear_kernel
@@ -34,6 +35,7 @@ module empm_shape_linear
     procedure :: eval_point => linear_eval_point
     procedure :: eval_batch => linear_eval_batch
     procedure :: name => linear_name
+    procedure :: layout => linear_layout
   end type empm_shape_linear_t
 
 contains
@@ -45,6 +47,16 @@ contains
     associate (unused_ => self); end associate
     linear_max_nodes = 2**grid%ndim
   end function linear_max_nodes
+
+  !> Basis layout: BASIS_Q4 on a 2D grid (the cell and two local coordinates per particle),
+  !> node lists otherwise.
+  pure integer function linear_layout(self, grid)
+    class(empm_shape_linear_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid          !! background grid
+    associate (unused_ => self); end associate
+    linear_layout = BASIS_LISTS
+    if (grid%ndim == 2) linear_layout = BASIS_Q4
+  end function linear_layout
 
   !> Family identifier: "linear".
   function linear_name(self) result(s)
@@ -79,19 +91,28 @@ contains
     integer, intent(out) :: ibad                   !! first failing particle, 0 if none
     integer, intent(out) :: info                   !! SHAPE_OK or the failing particle's code
     integer :: p, pinfo, nc, c, p0, p1, b
+    logical :: q4
     associate (unused_ => self); end associate
-    call shape_batch_fits(pts%np, basis, ibad, info)
+    call shape_batch_fits(pts%np, basis, ibad, info, q4=grid%ndim == 2)
     if (info /= SHAPE_OK) return
-    if (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4) then
+    q4 = basis%layout == BASIS_Q4
+    if (q4 .or. (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4)) then
       ! 2D: one bilinear kernel call per chunk of particles.
+      if (q4) then
+        basis%stride = grid%nn(1); basis%inv_h = grid%inv_h(1:2)
+      end if
       nc = empm_chunks(pts%np)
       ibad = huge(1)
       !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, b) &
       !$omp   reduction(min: ibad) if(nc > 1)
       do c = 0, nc - 1
         call empm_chunk_bounds(pts%np, nc, c, p0, p1)
-        call linear_range_2d(grid, p0, p1, pts%x, basis%maxn, basis%nn, basis%node, basis%N, &
-                             basis%dN, b)
+        if (q4) then
+          call q4_range(grid, p0, p1, pts%x, basis%cell, basis%t, b)
+        else
+          call linear_range_2d(grid, p0, p1, pts%x, basis%maxn, basis%nn, basis%node, &
+                               basis%N, basis%dN, b)
+        end if
         ibad = min(ibad, b)
       end do
       !$omp end parallel do
@@ -159,9 +180,9 @@ contains
     call shape_tp_assemble(grid, m, base, w, g, nn, node, N, dN, info)
   end subroutine shape_linear_kernel
 
-  !> Bilinear (Q4) values and gradients at particles p0..p1, written out: the hot path of 2D
-  !> runs, without the generic tensor-product assembly (the same values and node order, x
-  !> fastest). A particle outside the closed grid box (the test of grid%inside, which a NaN
+  !> Bilinear (Q4) values and gradients at particles p0..p1 into node lists, without the
+  !> generic tensor-product assembly (the same values and node order, x fastest; the values
+  !> are [[basis_q4_weights]], as for the compact layout). A particle outside the closed grid box (the test of grid%inside, which a NaN
   !> coordinate fails too) gets nn = 0; `ibad` is the first one, huge(1) if none.
   pure subroutine linear_range_2d(grid, p0, p1, x, mx, nn, node, N, dN, ibad)
     type(empm_grid_t), intent(in) :: grid    !! background grid (2D)
@@ -174,7 +195,7 @@ contains
     real(wp), intent(inout) :: N(mx, *)      !! values
     real(wp), intent(inout) :: dN(2, mx, *)  !! gradients
     integer, intent(out) :: ibad             !! first particle outside the grid, huge(1) if none
-    real(wp) :: o1, o2, e1, e2, h1, h2, s1, s2, t1, t2, u1, u2
+    real(wp) :: o1, o2, e1, e2, h1, h2, s1, s2, t1, t2
     integer :: p, i0, j0, id, n1, c1, c2
     o1 = grid%origin(1); o2 = grid%origin(2)
     e1 = grid%origin(1) + grid%ncell(1) * grid%h(1)
@@ -195,18 +216,50 @@ contains
       s2 = (x(2, p) - o2) * h2
       i0 = min(int(s1), c1)
       j0 = min(int(s2), c2)
-      t1 = min(s1 - i0, 1.0_wp); u1 = 1.0_wp - t1
-      t2 = min(s2 - j0, 1.0_wp); u2 = 1.0_wp - t2
+      t1 = min(s1 - i0, 1.0_wp)
+      t2 = min(s2 - j0, 1.0_wp)
       id = 1 + i0 + n1 * j0
       nn(p) = 4
       node(1, p) = id; node(2, p) = id + 1; node(3, p) = id + n1; node(4, p) = id + n1 + 1
-      N(1, p) = u1 * u2; N(2, p) = t1 * u2; N(3, p) = u1 * t2; N(4, p) = t1 * t2
-      dN(1, 1, p) = -h1 * u2; dN(2, 1, p) = -u1 * h2
-      dN(1, 2, p) = h1 * u2;  dN(2, 2, p) = -t1 * h2
-      dN(1, 3, p) = -h1 * t2; dN(2, 3, p) = u1 * h2
-      dN(1, 4, p) = h1 * t2;  dN(2, 4, p) = t1 * h2
+      call basis_q4_weights(t1, t2, h1, h2, N(1:4, p), dN(1:2, 1:4, p))
     end do
   end subroutine linear_range_2d
+
+  !> The compact bilinear basis (BASIS_Q4) at particles p0..p1: the lowest node of the cell
+  !> and the local coordinates, located exactly as [[linear_range_2d]] does (so the values
+  !> recomputed from them are the same bits). `ibad` as there; a bad particle's entries are
+  !> left as they were.
+  pure subroutine q4_range(grid, p0, p1, x, cell, t, ibad)
+    type(empm_grid_t), intent(in) :: grid    !! background grid (2D)
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    real(wp), intent(in) :: x(2, *)          !! particle positions
+    integer, intent(inout) :: cell(*)        !! lowest node of each particle's cell
+    real(wp), intent(inout) :: t(2, *)       !! local coordinates
+    integer, intent(out) :: ibad             !! first particle outside the grid, huge(1) if none
+    real(wp) :: o1, o2, e1, e2, h1, h2, s1, s2
+    integer :: p, i0, j0, n1, c1, c2
+    o1 = grid%origin(1); o2 = grid%origin(2)
+    e1 = grid%origin(1) + grid%ncell(1) * grid%h(1)
+    e2 = grid%origin(2) + grid%ncell(2) * grid%h(2)
+    h1 = grid%inv_h(1); h2 = grid%inv_h(2)
+    n1 = grid%nn(1); c1 = grid%ncell(1) - 1; c2 = grid%ncell(2) - 1
+    ibad = huge(1)
+    do p = p0, p1
+      if (.not. (x(1, p) >= o1 .and. x(1, p) <= e1 .and. x(2, p) >= o2 .and. &
+                 x(2, p) <= e2)) then
+        ibad = min(ibad, p)
+        cycle
+      end if
+      s1 = (x(1, p) - o1) * h1
+      s2 = (x(2, p) - o2) * h2
+      i0 = min(int(s1), c1)
+      j0 = min(int(s2), c2)
+      cell(p) = 1 + i0 + n1 * j0
+      t(1, p) = min(s1 - i0, 1.0_wp)
+      t(2, p) = min(s2 - j0, 1.0_wp)
+    end do
+  end subroutine q4_range
 
   !> Reset tensor-product factors to the neutral values used along directions beyond ndim:
   !> one node at index 0 with value 1 and derivative 0.
@@ -274,17 +327,32 @@ contains
   end subroutine shape_tp_assemble
 
   !> Check that `basis` has storage for `np` particles before a batch (the per-particle
-  !> capacity and dimension are checked by [[shape_tp_assemble]]).
-  !> On failure `info = SHAPE_TOO_MANY_NODES` and `ibad` is the first particle without storage.
-  pure subroutine shape_batch_fits(np, basis, ibad, info)
+  !> capacity and dimension are checked by [[shape_tp_assemble]]) in a layout the caller
+  !> fills: node lists always, BASIS_Q4 only with `q4 = .true.`. On failure `ibad` is the first
+  !> particle without storage and `info = SHAPE_TOO_MANY_NODES`, or `ibad = 1` and
+  !> `info = SHAPE_BAD_LAYOUT`.
+  pure subroutine shape_batch_fits(np, basis, ibad, info, q4)
     integer, intent(in) :: np                  !! number of particles to evaluate
     type(empm_basis_t), intent(in) :: basis    !! basis storage
     integer, intent(out) :: ibad               !! 0, or the first particle that does not fit
-    integer, intent(out) :: info               !! SHAPE_OK or SHAPE_TOO_MANY_NODES
+    integer, intent(out) :: info               !! SHAPE_OK, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT
+    logical, intent(in), optional :: q4        !! the caller can fill BASIS_Q4 (default: no)
+    logical :: q4_ok
     ibad = 0
     info = SHAPE_OK
     if (np <= 0) return
-    if (.not. allocated(basis%nn)) then
+    q4_ok = .false.
+    if (present(q4)) q4_ok = q4
+    if (basis%layout == BASIS_Q4) then
+      if (.not. q4_ok) then
+        ibad = 1; info = SHAPE_BAD_LAYOUT; return
+      end if
+      if (.not. allocated(basis%cell)) then
+        ibad = 1
+      else if (size(basis%cell) < np .or. size(basis%t, 2) < np) then
+        ibad = min(size(basis%cell), size(basis%t, 2)) + 1
+      end if
+    else if (.not. allocated(basis%nn)) then
       ibad = 1
     else if (size(basis%nn) < np .or. size(basis%node, 2) < np .or. size(basis%N, 2) < np &
              .or. size(basis%dN, 3) < np) then

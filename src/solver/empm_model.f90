@@ -58,7 +58,9 @@ contains
     ! Keep constraints set earlier with nodes%fix_box.
     if (.not. allocated(self%nodes%mass) .or. self%nodes%nnode /= self%grid%nnode) &
       call self%nodes%alloc(self%grid)
-    call self%basis%alloc(self%grid%ndim, self%shape%max_nodes(self%grid), np)
+    call self%nodes%list_fixed()
+    call self%basis%alloc(self%grid%ndim, self%shape%max_nodes(self%grid), np, &
+                          self%shape%layout(self%grid))
     ! Contiguous runs of particles sharing a material: one batched update per run.
     nrun = 0
     do p = 1, np

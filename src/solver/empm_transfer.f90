@@ -10,18 +10,21 @@
 !> thread count (reproducible run to run) and equal to the serial sums to round-off; with one
 !> thread, or without a workspace, they are the serial sums bit for bit.
 !>
-!> The kernels of the time step (mass + momentum, internal force, G2P, velocity gradient)
-!> dispatch on the dimension once per particle chunk: 2D runs use the specialised loops of
-!> [[empm_transfer_2d]] (same arithmetic, same order, same bits), other dimensions the generic
-!> loops here; the less frequent transfers (p2g_mass, p2g_weighted, body forces) are generic
-!> only. Nodal and particle arrays must be contiguous.
+!> Every kernel dispatches on the basis layout and dimension once per particle chunk: the
+!> compact bilinear layout (`BASIS_Q4`) goes to [[empm_transfer_q4]]; node lists in 2D to the
+!> specialised loops of [[empm_transfer_2d]] for the kernels of the time step (mass +
+!> momentum, internal force, G2P, velocity gradient); everything else to the generic loops
+!> here. All paths do the same arithmetic in the same order (same bits). Nodal and particle
+!> arrays must be contiguous.
 module empm_transfer
   use empm_kinds, only: wp
-  use empm_shape, only: empm_basis_t
+  use empm_shape, only: empm_basis_t, BASIS_Q4
   use empm_nodes, only: empm_nodes_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_transfer_2d, only: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, &
                               g2p_2d, g2p_pc_newmark_2d
+  use empm_transfer_q4, only: mass_q4, weighted_q4, mass_momentum_q4, body_force_q4, &
+                              internal_force_q4, velocity_gradient_q4, g2p_q4, g2p_pc_newmark_q4
   implicit none
   private
   public :: empm_p2g_work_t
@@ -74,14 +77,23 @@ contains
     do c = 2, self%nt
       call empm_chunk_bounds(basis%np, self%nt, c - 1, p0, p1)
       lo = huge(1); hi = 0
-      !$omp parallel do num_threads(self%nt) schedule(static) private(k) &
-      !$omp   reduction(min: lo) reduction(max: hi)
-      do p = p0, p1
-        do k = 1, basis%nn(p)
-          lo = min(lo, basis%node(k, p)); hi = max(hi, basis%node(k, p))
+      if (basis%layout == BASIS_Q4) then
+        !$omp parallel do num_threads(self%nt) schedule(static) &
+        !$omp   reduction(min: lo) reduction(max: hi)
+        do p = p0, p1
+          lo = min(lo, basis%cell(p)); hi = max(hi, basis%cell(p) + basis%stride + 1)
         end do
-      end do
-      !$omp end parallel do
+        !$omp end parallel do
+      else
+        !$omp parallel do num_threads(self%nt) schedule(static) private(k) &
+        !$omp   reduction(min: lo) reduction(max: hi)
+        do p = p0, p1
+          do k = 1, basis%nn(p)
+            lo = min(lo, basis%node(k, p)); hi = max(hi, basis%node(k, p))
+          end do
+        end do
+        !$omp end parallel do
+      end if
       if (hi == 0) lo = 1
       self%lo(c) = lo; self%hi(c) = hi
     end do
@@ -159,6 +171,9 @@ contains
     integer, intent(in) :: p0, p1
     real(wp), intent(inout) :: mass(:)
     integer :: p, k
+    if (basis%layout == BASIS_Q4) then
+      call mass_q4(basis%stride, p0, p1, basis%cell, basis%t, m, mass); return
+    end if
     do p = p0, p1
       do k = 1, basis%nn(p)
         mass(basis%node(k, p)) = mass(basis%node(k, p)) + basis%N(k, p) * m(p)
@@ -202,6 +217,9 @@ contains
     real(wp), intent(inout) :: q(:,:)
     real(wp) :: mu(3)
     integer :: p, k, I, d
+    if (basis%layout == BASIS_Q4) then
+      call weighted_q4(basis%stride, p0, p1, basis%cell, basis%t, m, u, c, w, q); return
+    end if
     d = size(u, 1)
     do p = p0, p1
       if (c == 0.0_wp) then
@@ -255,7 +273,9 @@ contains
     real(wp), intent(in), contiguous :: u(:,:), w(:,:)
     integer, intent(in) :: p0, p1
     real(wp), intent(inout), contiguous :: mass(:), q(:,:)
-    if (basis%ndim == 2) then
+    if (basis%layout == BASIS_Q4) then
+      call mass_momentum_q4(basis%stride, p0, p1, basis%cell, basis%t, m, u, c, w, mass, q)
+    else if (basis%ndim == 2) then
       call mass_momentum_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, m, u, c, w, &
                             mass, q)
     else
@@ -299,6 +319,11 @@ contains
     real(wp) :: s(3, 3), t
     integer :: p, k, I, d, a, b
     d = basis%ndim
+    if (basis%layout == BASIS_Q4) then
+      call internal_force_q4(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, vol, &
+                             stress, f)
+      return
+    end if
     if (d == 2) then
       call internal_force_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%dN, vol, stress, f)
       return
@@ -361,6 +386,9 @@ contains
     real(wp), intent(inout) :: f(:,:)
     real(wp) :: fp(3)
     integer :: p, k, I, d
+    if (basis%layout == BASIS_Q4) then
+      call body_force_q4(basis%stride, p0, p1, basis%cell, basis%t, m, g, b, use_b, f); return
+    end if
     d = size(g)
     do p = p0, p1
       fp(1:d) = g
@@ -383,6 +411,10 @@ contains
     !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k) if(nc > 1)
     do c = 0, nc - 1
       call empm_chunk_bounds(basis%np, nc, c, p0, p1)
+      if (basis%layout == BASIS_Q4) then
+        call g2p_q4(basis%stride, p0, p1, basis%cell, basis%t, q, .false., 0.0_wp, u)
+        cycle
+      end if
       if (basis%ndim == 2) then
         call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .false., 0.0_wp, u)
         cycle
@@ -410,6 +442,10 @@ contains
     !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, s) if(nc > 1)
     do ic = 0, nc - 1
       call empm_chunk_bounds(basis%np, nc, ic, p0, p1)
+      if (basis%layout == BASIS_Q4) then
+        call g2p_q4(basis%stride, p0, p1, basis%cell, basis%t, q, .true., c, u)
+        cycle
+      end if
       if (d == 2) then
         call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .true., c, u)
         cycle
@@ -445,6 +481,11 @@ contains
     !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, I, sv, sa) if(nc > 1)
     do c = 0, nc - 1
       call empm_chunk_bounds(basis%np, nc, c, p0, p1)
+      if (basis%layout == BASIS_Q4) then
+        call g2p_pc_newmark_q4(basis%stride, p0, p1, basis%cell, basis%t, dt, g, vel, acc, &
+                               x, v, a)
+        cycle
+      end if
       if (d == 2) then
         call g2p_pc_newmark_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, dt, g, &
                                vel, acc, x, v, a)
@@ -481,6 +522,10 @@ contains
     integer :: p, k, I, a, b, d
     d = basis%ndim
     if (p1 < p0) return
+    if (basis%layout == BASIS_Q4) then
+      call velocity_gradient_q4(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, v, L)
+      return
+    end if
     if (d == 2) then
       ! Element sequence association: the kernel sees particles p0..p1 as 1..p1-p0+1.
       call velocity_gradient_2d(basis%maxn, 1, p1 - p0 + 1, basis%nn(p0), basis%node(1, p0), &
@@ -504,10 +549,13 @@ contains
 
   !> out_I = q_I / m_I on nodes with mass above the empty-node threshold, 0 elsewhere.
   subroutine nodal_divide_by_mass(nodes, q, out)
-    type(empm_nodes_t), intent(in) :: nodes !! nodal fields (mass, mass_tol)
-    real(wp), intent(in) :: q(:,:)          !! nodal vectors (ndim, nnode)
-    real(wp), intent(out) :: out(:,:)       !! q/m (ndim, nnode)
+    type(empm_nodes_t), intent(in) :: nodes           !! nodal fields (mass, mass_tol)
+    real(wp), intent(in), contiguous :: q(:,:)        !! nodal vectors (ndim, nnode)
+    real(wp), intent(out), contiguous :: out(:,:)     !! q/m (ndim, nnode)
     integer :: I, d
+    if (nodes%ndim == 2) then
+      call divide_2d(nodes%nnode, nodes%mass, nodes%mass_tol, q, out); return
+    end if
     !$omp parallel do schedule(static) private(d) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
     do I = 1, nodes%nnode
       if (nodes%mass(I) > nodes%mass_tol) then
@@ -523,36 +571,60 @@ contains
     !$omp end parallel do
   end subroutine nodal_divide_by_mass
 
-  !> Impose Dirichlet conditions on nodal velocity (and the matching momentum).
-  subroutine constrain_velocity(nodes, v, mom)
-    type(empm_nodes_t), intent(in) :: nodes   !! nodal constraints and masses
-    real(wp), intent(inout) :: v(:,:)         !! nodal velocities (ndim, nnode)
-    real(wp), intent(inout) :: mom(:,:)       !! nodal momenta (ndim, nnode)
-    integer :: I, d
-    ! Explicit loops: a masked assignment here allocates a mask temporary per node.
-    !$omp parallel do schedule(static) private(d) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
-    do I = 1, nodes%nnode
-      do d = 1, nodes%ndim
-        if (nodes%fixed(d, I)) then
-          v(d, I) = nodes%vfix(d, I)
-          mom(d, I) = nodes%mass(I) * nodes%vfix(d, I)
-        end if
-      end do
+  !> [[nodal_divide_by_mass]] in 2D (pairs in registers; the same divisions).
+  subroutine divide_2d(n, mass, tol, q, out)
+    integer, intent(in) :: n
+    real(wp), intent(in) :: mass(n), tol, q(2, n)
+    real(wp), intent(out) :: out(2, n)
+    integer :: I
+    !$omp parallel do schedule(static) if(n >= EMPM_OMP_MIN_PARTICLES)
+    do I = 1, n
+      if (mass(I) > tol) then
+        out(:, I) = q(:, I) / mass(I)
+      else
+        out(:, I) = 0.0_wp
+      end if
     end do
     !$omp end parallel do
+  end subroutine divide_2d
+
+  !> Impose Dirichlet conditions on nodal velocity (and the matching momentum) on the fixed
+  !> dofs (`nodes%fixed_dofs`).
+  subroutine constrain_velocity(nodes, v, mom)
+    type(empm_nodes_t), intent(in) :: nodes           !! nodal constraints and masses
+    real(wp), intent(inout), contiguous :: v(:,:)     !! nodal velocities (ndim, nnode)
+    real(wp), intent(inout), contiguous :: mom(:,:)   !! nodal momenta (ndim, nnode)
+    call constrain_dofs(size(nodes%fixed_dofs), nodes%fixed_dofs, nodes%ndim, nodes%mass, &
+                        nodes%vfix, v, mom)
   end subroutine constrain_velocity
+
+  !> v = vfix and mom = m vfix on the listed dofs (positions in the (ndim, nnode) arrays).
+  pure subroutine constrain_dofs(n, dofs, nd, mass, vfix, v, mom)
+    integer, intent(in) :: n, dofs(n), nd
+    real(wp), intent(in) :: mass(*), vfix(*)
+    real(wp), intent(inout) :: v(*), mom(*)
+    integer :: k, j
+    do k = 1, n
+      j = dofs(k)
+      v(j) = vfix(j)
+      mom(j) = mass((j - 1) / nd + 1) * vfix(j)
+    end do
+  end subroutine constrain_dofs
 
   !> Zero nodal forces on fixed dofs (zero acceleration there).
   subroutine constrain_force(nodes, f)
-    type(empm_nodes_t), intent(in) :: nodes !! nodal constraints
-    real(wp), intent(inout) :: f(:,:)       !! nodal forces (ndim, nnode)
-    integer :: I, d
-    !$omp parallel do schedule(static) private(d) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
-    do I = 1, nodes%nnode
-      do d = 1, nodes%ndim
-        if (nodes%fixed(d, I)) f(d, I) = 0.0_wp
-      end do
-    end do
-    !$omp end parallel do
+    type(empm_nodes_t), intent(in) :: nodes           !! nodal constraints
+    real(wp), intent(inout), contiguous :: f(:,:)     !! nodal forces (ndim, nnode)
+    call zero_dofs(size(nodes%fixed_dofs), nodes%fixed_dofs, f)
   end subroutine constrain_force
+
+  !> f = 0 on the listed dofs.
+  pure subroutine zero_dofs(n, dofs, f)
+    integer, intent(in) :: n, dofs(n)
+    real(wp), intent(inout) :: f(*)
+    integer :: k
+    do k = 1, n
+      f(dofs(k)) = 0.0_wp
+    end do
+  end subroutine zero_dofs
 end module empm_transfer
