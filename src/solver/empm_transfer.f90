@@ -3,12 +3,18 @@
 !>
 !> No kernel allocates. With OpenMP, G2P kernels split the particles among the threads
 !> (each particle is independent, so results do not depend on the thread count). P2G is made
-!> race-free with per-thread nodal buffers ([[empm_p2g_work_t]], allocated once): the
-!> particles are cut into `nt` contiguous chunks, chunk 1 accumulates straight into the
-!> target, chunk c > 1 into buffer c, and the buffers are added to the target node by node, in
-!> chunk order, over the node range each chunk touched. Sums are therefore fixed for a given
-!> thread count (reproducible run to run) and equal to the serial sums to round-off; with one
-!> thread, or without a workspace, they are the serial sums bit for bit.
+!> race-free by a workspace ([[empm_p2g_work_t]], allocated once) in one of two modes, chosen
+!> after every basis evaluation from the node range each block of particles touches:
+!> - **two phases** (no buffers): the particles are cut into 2·nt contiguous sub-chunks; when
+!>   sub-chunks k and k + 2 never share a node (particles stored roughly in space order, as
+!>   the generators make them), the odd sub-chunks accumulate straight into the target in
+!>   parallel, then, after a barrier, the even ones;
+!> - **buffers** otherwise: the particles are cut into nt chunks, chunk 1 accumulates straight
+!>   into the target, chunk c > 1 into buffer c, and the buffers are added to the target node
+!>   by node, in chunk order, over the node range each chunk touched.
+!> Either way the sums are fixed for a given thread count and particle order (reproducible run
+!> to run) and equal to the serial sums to round-off; with one thread, or without a workspace,
+!> they are the serial sums bit for bit.
 !>
 !> Every kernel dispatches on the basis layout and dimension once per particle chunk: the
 !> compact bilinear layout (`BASIS_Q4`) goes to [[empm_transfer_q4]]; node lists in 2D to the
@@ -32,14 +38,18 @@ module empm_transfer
   public :: g2p_value, g2p_add_scaled, g2p_pc_newmark, velocity_gradient
   public :: nodal_divide_by_mass, constrain_velocity, constrain_force
 
-  !> Per-thread nodal accumulators of a race-free P2G; kept zero between calls.
+  !> Workspace of a race-free threaded P2G: the mode, the node ranges and the per-thread
+  !> nodal accumulators (kept zero between calls).
   type :: empm_p2g_work_t
     integer :: nt = 1                       !! particle chunks (threads); 1 = serial
+    logical :: two_phase = .false.          !! the current basis allows the two-phase mode
     real(wp), allocatable :: buf(:,:,:)     !! vector accumulators of chunks 2..nt (ndim, nnode, nt-1)
     real(wp), allocatable :: mbuf(:,:)      !! scalar (mass) accumulators of chunks 2..nt (nnode, nt-1)
     integer, allocatable :: lo(:)           !! first node touched by each chunk (nt); set by
                                             !! set_ranges after every basis evaluation
     integer, allocatable :: hi(:)           !! last node touched by each chunk (nt)
+    integer, allocatable :: slo(:)          !! first node touched by each sub-chunk (2 nt)
+    integer, allocatable :: shi(:)          !! last node touched by each sub-chunk (2 nt)
   contains
     procedure :: init => p2g_work_init
     procedure :: set_ranges => p2g_work_set_ranges
@@ -57,25 +67,27 @@ contains
     integer, intent(in) :: nthreads               !! threads to use
     self%nt = max(1, nthreads)
     if (np < EMPM_OMP_MIN_PARTICLES) self%nt = 1
-    if (allocated(self%buf)) deallocate(self%buf, self%mbuf, self%lo, self%hi)
+    if (allocated(self%buf)) deallocate(self%buf, self%mbuf, self%lo, self%hi, self%slo, self%shi)
     allocate(self%buf(ndim, nnode, self%nt - 1), self%mbuf(nnode, self%nt - 1), &
-             self%lo(self%nt), self%hi(self%nt))
+             self%lo(self%nt), self%hi(self%nt), self%slo(2 * self%nt), self%shi(2 * self%nt))
     self%buf = 0.0_wp; self%mbuf = 0.0_wp
-    self%lo = 1; self%hi = 0
+    self%lo = 1; self%hi = 0; self%slo = 1; self%shi = 0
+    self%two_phase = .false.
   end subroutine p2g_work_init
 
-  !> Record the node range touched by each particle chunk for the current basis. The basis
+  !> Record the node range touched by each particle sub-chunk and chunk for the current basis
+  !> and choose the mode (two phases when sub-chunks k and k + 2 share no node). The basis
   !> changes once per step, so this runs once per step (after the shape functions) instead of
-  !> in every P2G call; the chunks' ranges are computed in parallel.
+  !> in every P2G call; the ranges are computed in parallel.
   subroutine p2g_work_set_ranges(self, basis)
     class(empm_p2g_work_t), intent(inout) :: self !! workspace
     type(empm_basis_t), intent(in) :: basis       !! shape functions at the particles
     integer :: c, p0, p1, p, k, lo, hi
     if (self%nt <= 1) return
-    ! Chunk by chunk, each one's particles shared by all threads (a loop over the chunks
-    ! would leave one thread alone with chunk 2 when there are two).
-    do c = 2, self%nt
-      call empm_chunk_bounds(basis%np, self%nt, c - 1, p0, p1)
+    ! Sub-chunk by sub-chunk, each one's particles shared by all threads (a loop over the
+    ! sub-chunks would leave threads idle when there are few of them).
+    do c = 1, 2 * self%nt
+      call empm_chunk_bounds(basis%np, 2 * self%nt, c - 1, p0, p1)
       lo = huge(1); hi = 0
       if (basis%layout == BASIS_Q4) then
         !$omp parallel do num_threads(self%nt) schedule(static) &
@@ -94,10 +106,41 @@ contains
         end do
         !$omp end parallel do
       end if
-      if (hi == 0) lo = 1
-      self%lo(c) = lo; self%hi(c) = hi
+      if (hi == 0) lo = huge(1) ! empty: shares no node with anything
+      self%slo(c) = lo; self%shi(c) = hi
+    end do
+    ! Chunk c is sub-chunks 2c − 1 and 2c (the same particle bounds).
+    do c = 1, self%nt
+      self%lo(c) = min(self%slo(2 * c - 1), self%slo(2 * c))
+      self%hi(c) = max(self%shi(2 * c - 1), self%shi(2 * c))
+      if (self%hi(c) == 0) self%lo(c) = 1
+    end do
+    self%two_phase = .true.
+    do c = 1, 2 * self%nt - 2
+      if (self%shi(c) >= self%slo(c + 2)) self%two_phase = .false.
     end do
   end subroutine p2g_work_set_ranges
+
+  !> Task `it` (1..nt) of phase `ph` of a threaded P2G over `np` particles: its particles
+  !> p0..p1 and where they accumulate (`dst` = 0: the target; c > 0: buffer c).
+  pure subroutine p2g_task(ws, np, ph, it, p0, p1, dst)
+    type(empm_p2g_work_t), intent(in) :: ws
+    integer, intent(in) :: np, ph, it
+    integer, intent(out) :: p0, p1, dst
+    if (ws%two_phase) then
+      call empm_chunk_bounds(np, 2 * ws%nt, 2 * (it - 1) + ph - 1, p0, p1)
+      dst = 0
+    else
+      call empm_chunk_bounds(np, ws%nt, it - 1, p0, p1)
+      dst = it - 1
+    end if
+  end subroutine p2g_task
+
+  !> Phases of a threaded P2G in the current mode.
+  pure integer function p2g_phases(ws)
+    type(empm_p2g_work_t), intent(in) :: ws
+    p2g_phases = merge(2, 1, ws%two_phase)
+  end function p2g_phases
 
   !> True when a P2G call runs on per-thread chunks (a workspace with more than one chunk).
   pure logical function threaded(ws)
@@ -111,6 +154,7 @@ contains
     type(empm_p2g_work_t), intent(inout) :: ws
     real(wp), intent(inout) :: q(:,:)
     integer :: I, c, ilo, ihi
+    if (ws%two_phase) return ! nothing in the buffers
     ilo = minval(ws%lo(2:ws%nt)); ihi = maxval(ws%hi(2:ws%nt))
     !$omp do schedule(static)
     do I = ilo, ihi
@@ -128,6 +172,7 @@ contains
     type(empm_p2g_work_t), intent(inout) :: ws
     real(wp), intent(inout) :: q(:)
     integer :: I, c, ilo, ihi
+    if (ws%two_phase) return ! nothing in the buffers
     ilo = minval(ws%lo(2:ws%nt)); ihi = maxval(ws%hi(2:ws%nt))
     !$omp do schedule(static)
     do I = ilo, ihi
@@ -145,22 +190,24 @@ contains
     type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
     real(wp), intent(in) :: m(:)                             !! particle masses
     real(wp), intent(inout) :: mass(:)                       !! nodal masses (accumulated)
-    type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
-    integer :: c, p0, p1
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
+    integer :: c, p0, p1, ph, dst
     if (.not. threaded(ws)) then
       call mass_range(basis, m, 1, basis%np, mass); return
     end if
-    !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
-    !$omp do schedule(static, 1)
-    do c = 1, ws%nt
-      call empm_chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
-      if (c == 1) then
-        call mass_range(basis, m, p0, p1, mass)
-      else
-        call mass_range(basis, m, p0, p1, ws%mbuf(:, c - 1))
-      end if
+    !$omp parallel num_threads(ws%nt) default(shared) private(ph, c, p0, p1, dst)
+    do ph = 1, p2g_phases(ws)
+      !$omp do schedule(static, 1)
+      do c = 1, ws%nt
+        call p2g_task(ws, basis%np, ph, c, p0, p1, dst)
+        if (dst == 0) then
+          call mass_range(basis, m, p0, p1, mass)
+        else
+          call mass_range(basis, m, p0, p1, ws%mbuf(:, dst))
+        end if
+      end do
+      !$omp end do
     end do
-    !$omp end do
     call reduce_scalar(ws, mass)
     !$omp end parallel
   end subroutine p2g_mass
@@ -190,22 +237,24 @@ contains
     real(wp), intent(in) :: c                                !! scale of the second vector (0 to ignore it)
     real(wp), intent(in) :: w(:,:)                           !! second particle vectors (ndim, np)
     real(wp), intent(inout) :: q(:,:)                        !! nodal vectors (ndim, nnode), accumulated
-    type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
-    integer :: ic, p0, p1
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
+    integer :: ic, p0, p1, ph, dst
     if (.not. threaded(ws)) then
       call weighted_range(basis, m, u, c, w, 1, basis%np, q); return
     end if
-    !$omp parallel num_threads(ws%nt) default(shared) private(ic, p0, p1)
-    !$omp do schedule(static, 1)
-    do ic = 1, ws%nt
-      call empm_chunk_bounds(basis%np, ws%nt, ic - 1, p0, p1)
-      if (ic == 1) then
-        call weighted_range(basis, m, u, c, w, p0, p1, q)
-      else
-        call weighted_range(basis, m, u, c, w, p0, p1, ws%buf(:, :, ic - 1))
-      end if
+    !$omp parallel num_threads(ws%nt) default(shared) private(ph, ic, p0, p1, dst)
+    do ph = 1, p2g_phases(ws)
+      !$omp do schedule(static, 1)
+      do ic = 1, ws%nt
+        call p2g_task(ws, basis%np, ph, ic, p0, p1, dst)
+        if (dst == 0) then
+          call weighted_range(basis, m, u, c, w, p0, p1, q)
+        else
+          call weighted_range(basis, m, u, c, w, p0, p1, ws%buf(:, :, dst))
+        end if
+      end do
+      !$omp end do
     end do
-    !$omp end do
     call reduce_vec(ws, q)
     !$omp end parallel
   end subroutine p2g_weighted
@@ -245,23 +294,25 @@ contains
     real(wp), intent(in), contiguous :: w(:,:)               !! second particle vectors (ndim, np)
     real(wp), intent(inout), contiguous :: mass(:)           !! nodal masses (accumulated)
     real(wp), intent(inout), contiguous :: q(:,:)            !! nodal vectors (ndim, nnode), accumulated
-    type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
-    integer :: ic, p0, p1
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
+    integer :: ic, p0, p1, ph, dst
     if (.not. threaded(ws)) then
       call mass_momentum_range(basis, m, u, c, w, 1, basis%np, mass, q); return
     end if
-    !$omp parallel num_threads(ws%nt) default(shared) private(ic, p0, p1)
-    !$omp do schedule(static, 1)
-    do ic = 1, ws%nt
-      call empm_chunk_bounds(basis%np, ws%nt, ic - 1, p0, p1)
-      if (ic == 1) then
-        call mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q)
-      else
-        call mass_momentum_range(basis, m, u, c, w, p0, p1, ws%mbuf(:, ic - 1), &
-                                 ws%buf(:, :, ic - 1))
-      end if
+    !$omp parallel num_threads(ws%nt) default(shared) private(ph, ic, p0, p1, dst)
+    do ph = 1, p2g_phases(ws)
+      !$omp do schedule(static, 1)
+      do ic = 1, ws%nt
+        call p2g_task(ws, basis%np, ph, ic, p0, p1, dst)
+        if (dst == 0) then
+          call mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q)
+        else
+          call mass_momentum_range(basis, m, u, c, w, p0, p1, ws%mbuf(:, dst), &
+                                   ws%buf(:, :, dst))
+        end if
+      end do
+      !$omp end do
     end do
-    !$omp end do
     call reduce_scalar(ws, mass)
     call reduce_vec(ws, q)
     !$omp end parallel
@@ -290,22 +341,24 @@ contains
     real(wp), intent(in) :: vol(:)                           !! particle volumes
     real(wp), intent(in), contiguous :: stress(:,:)          !! Cauchy stress (6, np)
     real(wp), intent(inout), contiguous :: f(:,:)            !! nodal forces (ndim, nnode), accumulated
-    type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
-    integer :: c, p0, p1
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
+    integer :: c, p0, p1, ph, dst
     if (.not. threaded(ws)) then
       call internal_range(basis, vol, stress, 1, basis%np, f); return
     end if
-    !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
-    !$omp do schedule(static, 1)
-    do c = 1, ws%nt
-      call empm_chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
-      if (c == 1) then
-        call internal_range(basis, vol, stress, p0, p1, f)
-      else
-        call internal_range(basis, vol, stress, p0, p1, ws%buf(:, :, c - 1))
-      end if
+    !$omp parallel num_threads(ws%nt) default(shared) private(ph, c, p0, p1, dst)
+    do ph = 1, p2g_phases(ws)
+      !$omp do schedule(static, 1)
+      do c = 1, ws%nt
+        call p2g_task(ws, basis%np, ph, c, p0, p1, dst)
+        if (dst == 0) then
+          call internal_range(basis, vol, stress, p0, p1, f)
+        else
+          call internal_range(basis, vol, stress, p0, p1, ws%buf(:, :, dst))
+        end if
+      end do
+      !$omp end do
     end do
-    !$omp end do
     call reduce_vec(ws, f)
     !$omp end parallel
   end subroutine p2g_internal_force
@@ -356,24 +409,26 @@ contains
     real(wp), intent(in) :: b(:,:)                           !! per-particle body force per unit mass (ndim, np)
     logical, intent(in) :: use_b                             !! whether `b` holds data
     real(wp), intent(inout) :: f(:,:)                        !! nodal forces (ndim, nnode), accumulated
-    type(empm_p2g_work_t), intent(inout), optional :: ws     !! per-thread buffers (threaded P2G)
-    integer :: c, p0, p1
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
+    integer :: c, p0, p1, ph, dst
     ! Nothing to add: skip the pass (adding zeros leaves f unchanged bit for bit).
     if (.not. use_b .and. all(g == 0.0_wp)) return
     if (.not. threaded(ws)) then
       call body_range(basis, m, g, b, use_b, 1, basis%np, f); return
     end if
-    !$omp parallel num_threads(ws%nt) default(shared) private(c, p0, p1)
-    !$omp do schedule(static, 1)
-    do c = 1, ws%nt
-      call empm_chunk_bounds(basis%np, ws%nt, c - 1, p0, p1)
-      if (c == 1) then
-        call body_range(basis, m, g, b, use_b, p0, p1, f)
-      else
-        call body_range(basis, m, g, b, use_b, p0, p1, ws%buf(:, :, c - 1))
-      end if
+    !$omp parallel num_threads(ws%nt) default(shared) private(ph, c, p0, p1, dst)
+    do ph = 1, p2g_phases(ws)
+      !$omp do schedule(static, 1)
+      do c = 1, ws%nt
+        call p2g_task(ws, basis%np, ph, c, p0, p1, dst)
+        if (dst == 0) then
+          call body_range(basis, m, g, b, use_b, p0, p1, f)
+        else
+          call body_range(basis, m, g, b, use_b, p0, p1, ws%buf(:, :, dst))
+        end if
+      end do
+      !$omp end do
     end do
-    !$omp end do
     call reduce_vec(ws, f)
     !$omp end parallel
   end subroutine p2g_body_force
