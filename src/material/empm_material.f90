@@ -25,7 +25,9 @@ module empm_material
   abstract interface
     !> Advance the state of `n` particles over a step `dt` with velocity gradients `L`.
     !> Updates the deformation gradient, the accumulated strain, the Cauchy stress and the
-    !> density (rho is updated as the model's kinematics dictate; see each model).
+    !> density (rho is updated as the model's kinematics dictate; see each model). The arrays
+    !> are contiguous (the particle arrays' sections for a run of particles are; anything else
+    !> is copied in and out by the compiler).
     pure subroutine update_iface(self, dt, L, F, strain, stress, rho, info)
       import :: empm_material_t, wp
       class(empm_material_t), intent(in) :: self  !! material
