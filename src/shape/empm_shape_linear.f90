@@ -181,9 +181,9 @@ contains
   end subroutine shape_linear_kernel
 
   !> Bilinear (Q4) values and gradients at particles p0..p1 into node lists, without the
-  !> generic tensor-product assembly (the same values and node order, x fastest; the values
-  !> are [[basis_q4_weights]], as for the compact layout). A particle outside the closed grid box (the test of grid%inside, which a NaN
-  !> coordinate fails too) gets nn = 0; `ibad` is the first one, huge(1) if none.
+  !> generic tensor-product assembly (the same values and node order, x fastest; located by
+  !> [[q4_range]], values by [[basis_q4_weights]], as for the compact layout). A particle
+  !> outside the closed grid box gets nn = 0; `ibad` is the first one, huge(1) if none.
   pure subroutine linear_range_2d(grid, p0, p1, x, mx, nn, node, N, dN, ibad)
     type(empm_grid_t), intent(in) :: grid    !! background grid (2D)
     integer, intent(in) :: p0                !! first particle
@@ -195,40 +195,31 @@ contains
     real(wp), intent(inout) :: N(mx, *)      !! values
     real(wp), intent(inout) :: dN(2, mx, *)  !! gradients
     integer, intent(out) :: ibad             !! first particle outside the grid, huge(1) if none
-    real(wp) :: o1, o2, e1, e2, h1, h2, s1, s2, t1, t2
-    integer :: p, i0, j0, id, n1, c1, c2
-    o1 = grid%origin(1); o2 = grid%origin(2)
-    e1 = grid%origin(1) + grid%ncell(1) * grid%h(1)
-    e2 = grid%origin(2) + grid%ncell(2) * grid%h(2)
-    h1 = grid%inv_h(1); h2 = grid%inv_h(2)
-    n1 = grid%nn(1); c1 = grid%ncell(1) - 1; c2 = grid%ncell(2) - 1
+    real(wp) :: t(2, 1)
+    integer :: p, id(1), n1, b
+    n1 = grid%nn(1)
     ibad = huge(1)
     do p = p0, p1
-      if (.not. (x(1, p) >= o1 .and. x(1, p) <= e1 .and. x(2, p) >= o2 .and. &
-                 x(2, p) <= e2)) then
+      ! Located as for the compact layout (one particle: x(1, p) starts its coordinate pair).
+      call q4_range(grid, 1, 1, x(1, p), id, t, b)
+      if (b /= huge(1)) then
         nn(p) = 0
         ibad = min(ibad, p)
         cycle
       end if
-      ! Inside the box, s ≥ 0: floor is int, and s − i0 ≥ 0 needs no clamp from below; the
-      ! upper face belongs to the last cell.
-      s1 = (x(1, p) - o1) * h1
-      s2 = (x(2, p) - o2) * h2
-      i0 = min(int(s1), c1)
-      j0 = min(int(s2), c2)
-      t1 = min(s1 - i0, 1.0_wp)
-      t2 = min(s2 - j0, 1.0_wp)
-      id = 1 + i0 + n1 * j0
       nn(p) = 4
-      node(1, p) = id; node(2, p) = id + 1; node(3, p) = id + n1; node(4, p) = id + n1 + 1
-      call basis_q4_weights(t1, t2, h1, h2, N(1:4, p), dN(1:2, 1:4, p))
+      node(1, p) = id(1); node(2, p) = id(1) + 1
+      node(3, p) = id(1) + n1; node(4, p) = id(1) + n1 + 1
+      call basis_q4_weights(t(1, 1), t(2, 1), grid%inv_h(1), grid%inv_h(2), N(1:4, p), &
+                            dN(1:2, 1:4, p))
     end do
   end subroutine linear_range_2d
 
   !> The compact bilinear basis (BASIS_Q4) at particles p0..p1: the lowest node of the cell
-  !> and the local coordinates, located exactly as [[linear_range_2d]] does (so the values
-  !> recomputed from them are the same bits). `ibad` as there; a bad particle's entries are
-  !> left as they were.
+  !> and the local coordinates (also how [[linear_range_2d]] locates a particle, so both
+  !> layouts hold the same bits). A particle outside the closed grid box (the test of
+  !> grid%inside, which a NaN coordinate fails too) is left as it was; `ibad` is the first
+  !> one, huge(1) if none.
   pure subroutine q4_range(grid, p0, p1, x, cell, t, ibad)
     type(empm_grid_t), intent(in) :: grid    !! background grid (2D)
     integer, intent(in) :: p0                !! first particle
@@ -251,6 +242,8 @@ contains
         ibad = min(ibad, p)
         cycle
       end if
+      ! Inside the box, s ≥ 0: floor is int, and s − i0 ≥ 0 needs no clamp from below; the
+      ! upper face belongs to the last cell.
       s1 = (x(1, p) - o1) * h1
       s2 = (x(2, p) - o2) * h2
       i0 = min(int(s1), c1)
