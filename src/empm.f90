@@ -14,7 +14,8 @@ module empm
   use empm_nodes, only: empm_nodes_t
   use empm_particles, only: empm_particles_t
   use empm_particle_gen, only: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
-  use empm_shape, only: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK
+  use empm_shape, only: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK, BASIS_LISTS, &
+                        BASIS_Q4
   use empm_shape_factory, only: empm_shape_create, empm_shape_names
   use empm_shape_lme, only: empm_shape_lme_t, LME_REMEDY_NONE, LME_REMEDY_ENLARGE
   use empm_lme_legacy, only: empm_lme_basis
@@ -41,7 +42,7 @@ module empm
   ! Discretisation
   public :: empm_grid_t, empm_nodes_t, empm_particles_t
   public :: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
-  public :: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK
+  public :: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK, BASIS_LISTS, BASIS_Q4
   public :: empm_shape_create, empm_shape_names
   public :: empm_shape_lme_t, LME_REMEDY_NONE, LME_REMEDY_ENLARGE, empm_lme_basis
   ! Materials and loads
