@@ -82,7 +82,7 @@ contains
   subroutine p2g_work_set_ranges(self, basis)
     class(empm_p2g_work_t), intent(inout) :: self !! workspace
     type(empm_basis_t), intent(in) :: basis       !! shape functions at the particles
-    integer :: c, p0, p1, p, k, lo, hi
+    integer :: c, p0, p1, p, k, lo, hi, last(0:1)
     if (self%nt <= 1) return
     ! Sub-chunk by sub-chunk, each one's particles shared by all threads (a loop over the
     ! sub-chunks would leave threads idle when there are few of them).
@@ -115,9 +115,15 @@ contains
       self%hi(c) = max(self%shi(2 * c - 1), self%shi(2 * c))
       if (self%hi(c) == 0) self%lo(c) = 1
     end do
+    ! Two phases when, within each phase (odd, even sub-chunks), every non-empty sub-chunk
+    ! starts above the last node of the previous non-empty one: the ranges then increase, so no
+    ! two of them overlap (an empty sub-chunk must not hide an overlap across it).
     self%two_phase = .true.
-    do c = 1, 2 * self%nt - 2
-      if (self%shi(c) >= self%slo(c + 2)) self%two_phase = .false.
+    last = 0
+    do c = 1, 2 * self%nt
+      if (self%shi(c) == 0) cycle
+      if (self%slo(c) <= last(mod(c, 2))) self%two_phase = .false.
+      last(mod(c, 2)) = self%shi(c)
     end do
   end subroutine p2g_work_set_ranges
 
