@@ -5,15 +5,16 @@
 !> [[empm_solve]] with an integrator. Extension points: [[empm_shape_t]],
 !> [[empm_material_t]], [[empm_integrator_t]].
 module empm
-  use empm_kinds, only: wp, pi
+  use empm_kinds, only: empm_wp => wp, empm_pi => pi
   use empm_version_info, only: empm_version
   use empm_error, only: empm_error_t, EMPM_OK, EMPM_ERR_USAGE, EMPM_ERR_INPUT, &
                         EMPM_ERR_RUNTIME, EMPM_ERR_IO
-  use empm_tensor, only: voigt_to_mat, mat_to_voigt
+  use empm_tensor, only: empm_voigt_to_mat => voigt_to_mat, empm_mat_to_voigt => mat_to_voigt
   use empm_grid, only: empm_grid_t
   use empm_nodes, only: empm_nodes_t
   use empm_particles, only: empm_particles_t
-  use empm_particle_gen, only: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
+  use empm_particle_gen, only: empm_fill, EMPM_GEOM_BOX => GEOM_BOX, EMPM_GEOM_DISK => GEOM_DISK, &
+                               EMPM_PLACE_GAUSS => PLACE_GAUSS, EMPM_PLACE_VOXEL => PLACE_VOXEL
   use empm_shape, only: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK, BASIS_LISTS, &
                         BASIS_Q4
   use empm_shape_factory, only: empm_shape_create, empm_shape_names
@@ -29,19 +30,15 @@ module empm
   use empm_solver, only: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
   use empm_output, only: empm_write_results, empm_output_meta_t
   use empm_driver, only: empm_run_case
-  use empm_exact_bar, only: empm_vibrating_bar_t
-  use empm_mms, only: empm_mms_t
-  use empm_spectrum, only: empm_power_spectrum, empm_energy_share_above
-  use empm_linalg, only: empm_eigenvalues, empm_spectral_radius
   implicit none
   private
   ! Kinds, version, errors
-  public :: wp, pi, empm_version, empm_error_t
+  public :: empm_wp, empm_pi, empm_version, empm_error_t
   public :: EMPM_OK, EMPM_ERR_USAGE, EMPM_ERR_INPUT, EMPM_ERR_RUNTIME, EMPM_ERR_IO
-  public :: voigt_to_mat, mat_to_voigt
+  public :: empm_voigt_to_mat, empm_mat_to_voigt
   ! Discretisation
   public :: empm_grid_t, empm_nodes_t, empm_particles_t
-  public :: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
+  public :: empm_fill, EMPM_GEOM_BOX, EMPM_GEOM_DISK, EMPM_PLACE_GAUSS, EMPM_PLACE_VOXEL
   public :: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK, BASIS_LISTS, BASIS_Q4
   public :: empm_shape_create, empm_shape_names
   public :: empm_shape_lme_t, LME_REMEDY_NONE, LME_REMEDY_ENLARGE, empm_lme_basis
@@ -54,7 +51,4 @@ module empm
   public :: empm_history_t, empm_snapshot_t
   public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
   public :: empm_write_results, empm_output_meta_t, empm_run_case
-  ! Analysis: exact solutions, spectra, eigenvalues
-  public :: empm_vibrating_bar_t, empm_mms_t, empm_power_spectrum, empm_energy_share_above
-  public :: empm_eigenvalues, empm_spectral_radius
 end module empm
