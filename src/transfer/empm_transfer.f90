@@ -14,7 +14,8 @@
 !>   by node, in chunk order, over the node range each chunk touched.
 !> Either way the sums are fixed for a given thread count and particle order (reproducible run
 !> to run) and equal to the serial sums to round-off; with one thread, or without a workspace,
-!> they are the serial sums bit for bit.
+!> they are the serial sums bit for bit. One driver, [[p2g_drive]], runs this skeleton for
+!> every P2G kernel; what it accumulates is selected once per particle range ([[p2g_range]]).
 !>
 !> Every kernel dispatches on the basis layout and dimension once per particle chunk: the
 !> compact bilinear layout (`BASIS_Q4`) goes to [[empm_transfer_q4]]; node lists in 2D to the
@@ -55,6 +56,13 @@ module empm_transfer
     procedure :: set_ranges => p2g_work_set_ranges
   end type empm_p2g_work_t
 
+  ! What a P2G pass accumulates: the selector of [[p2g_drive]] and [[p2g_range]].
+  integer, parameter :: OP_MASS = 1           ! m_I ([[p2g_mass]])
+  integer, parameter :: OP_WEIGHTED = 2       ! q_I ([[p2g_weighted]])
+  integer, parameter :: OP_MASS_MOMENTUM = 3  ! m_I and q_I in one pass ([[p2g_mass_momentum]])
+  integer, parameter :: OP_INTERNAL_FORCE = 4 ! internal force ([[p2g_internal_force]])
+  integer, parameter :: OP_BODY_FORCE = 5     ! body force ([[p2g_body_force]])
+
 contains
 
   !> Size the workspace for `nthreads` threads (serial when there are too few particles for
@@ -90,15 +98,15 @@ contains
       call empm_chunk_bounds(basis%np, 2 * self%nt, c - 1, p0, p1)
       lo = huge(1); hi = 0
       if (basis%layout == BASIS_Q4) then
-        !$omp parallel do num_threads(self%nt) schedule(static) &
-        !$omp   reduction(min: lo) reduction(max: hi)
+        !$omp parallel do num_threads(self%nt) schedule(static) default(none) &
+        !$omp   shared(basis, p0, p1) reduction(min: lo) reduction(max: hi)
         do p = p0, p1
           lo = min(lo, basis%cell(p)); hi = max(hi, basis%cell(p) + basis%stride + 1)
         end do
         !$omp end parallel do
       else
-        !$omp parallel do num_threads(self%nt) schedule(static) private(k) &
-        !$omp   reduction(min: lo) reduction(max: hi)
+        !$omp parallel do num_threads(self%nt) schedule(static) default(none) &
+        !$omp   shared(basis, p0, p1) private(k) reduction(min: lo) reduction(max: hi)
         do p = p0, p1
           do k = 1, basis%nn(p)
             lo = min(lo, basis%node(k, p)); hi = max(hi, basis%node(k, p))
@@ -130,9 +138,13 @@ contains
   !> Task `it` (1..nt) of phase `ph` of a threaded P2G over `np` particles: its particles
   !> p0..p1 and where they accumulate (`dst` = 0: the target; c > 0: buffer c).
   pure subroutine p2g_task(ws, np, ph, it, p0, p1, dst)
-    type(empm_p2g_work_t), intent(in) :: ws
-    integer, intent(in) :: np, ph, it
-    integer, intent(out) :: p0, p1, dst
+    type(empm_p2g_work_t), intent(in) :: ws !! threaded-P2G workspace
+    integer, intent(in) :: np               !! number of particles
+    integer, intent(in) :: ph               !! phase, 1..p2g_phases(ws)
+    integer, intent(in) :: it               !! task, 1..nt
+    integer, intent(out) :: p0              !! first particle
+    integer, intent(out) :: p1              !! last particle
+    integer, intent(out) :: dst             !! 0: the target; c > 0: buffer c
     if (ws%two_phase) then
       call empm_chunk_bounds(np, 2 * ws%nt, 2 * (it - 1) + ph - 1, p0, p1)
       dst = 0
@@ -144,21 +156,21 @@ contains
 
   !> Phases of a threaded P2G in the current mode.
   pure integer function p2g_phases(ws)
-    type(empm_p2g_work_t), intent(in) :: ws
+    type(empm_p2g_work_t), intent(in) :: ws !! threaded-P2G workspace
     p2g_phases = merge(2, 1, ws%two_phase)
   end function p2g_phases
 
   !> True when a P2G call runs on per-thread chunks (a workspace with more than one chunk).
   pure logical function threaded(ws)
-    type(empm_p2g_work_t), intent(in), optional :: ws
+    type(empm_p2g_work_t), intent(in), optional :: ws !! threaded-P2G workspace
     threaded = .false.
     if (present(ws)) threaded = ws%nt > 1
   end function threaded
 
   !> Add the chunk buffers to `q` (in chunk order) and zero them again.
   subroutine reduce_vec(ws, q)
-    type(empm_p2g_work_t), intent(inout) :: ws
-    real(wp), intent(inout) :: q(:,:)
+    type(empm_p2g_work_t), intent(inout) :: ws !! threaded-P2G workspace (buffers zeroed)
+    real(wp), intent(inout) :: q(:,:)          !! nodal vectors (ndim, nnode), accumulated
     integer :: I, c, ilo, ihi
     if (ws%two_phase) return ! nothing in the buffers
     ilo = minval(ws%lo(2:ws%nt)); ihi = maxval(ws%hi(2:ws%nt))
@@ -175,8 +187,8 @@ contains
 
   !> As [[reduce_vec]] for a scalar nodal field (the scalar buffers).
   subroutine reduce_scalar(ws, q)
-    type(empm_p2g_work_t), intent(inout) :: ws
-    real(wp), intent(inout) :: q(:)
+    type(empm_p2g_work_t), intent(inout) :: ws !! threaded-P2G workspace (buffers zeroed)
+    real(wp), intent(inout) :: q(:)            !! nodal scalars (accumulated)
     integer :: I, c, ilo, ihi
     if (ws%two_phase) return ! nothing in the buffers
     ilo = minval(ws%lo(2:ws%nt)); ihi = maxval(ws%hi(2:ws%nt))
@@ -195,34 +207,147 @@ contains
   subroutine p2g_mass(basis, m, mass, ws)
     type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
     real(wp), intent(in) :: m(:)                             !! particle masses
-    real(wp), intent(inout) :: mass(:)                       !! nodal masses (accumulated)
+    real(wp), intent(inout), contiguous :: mass(:)           !! nodal masses (accumulated)
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    integer :: c, p0, p1, ph, dst
+    call p2g_drive(OP_MASS, basis, ws, m=m, mass=mass)
+  end subroutine p2g_mass
+
+  !> Mass-weighted transfer q_I += Σ_p N_Ip m_p (u_p + c·w_p), e.g. momentum (c = 0) or the
+  !> predictor's v_p + (1−γ)Δt a_p.
+  subroutine p2g_weighted(basis, m, u, c, w, q, ws)
+    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                             !! particle masses
+    real(wp), intent(in), contiguous :: u(:,:)               !! particle vectors (ndim, np)
+    real(wp), intent(in) :: c                                !! scale of the second vector (0 to ignore it)
+    real(wp), intent(in), contiguous :: w(:,:)               !! second particle vectors (ndim, np)
+    real(wp), intent(inout), contiguous :: q(:,:)            !! nodal vectors (ndim, nnode), accumulated
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
+    call p2g_drive(OP_WEIGHTED, basis, ws, m=m, u=u, c=c, w=w, q=q)
+  end subroutine p2g_weighted
+
+  !> Lumped mass and a mass-weighted vector in one pass over the particles:
+  !> m_I += Σ_p N_Ip m_p and q_I += Σ_p N_Ip m_p (u_p + c·w_p). The same sums as
+  !> [[p2g_mass]] followed by [[p2g_weighted]], bit for bit, reading the basis once.
+  subroutine p2g_mass_momentum(basis, m, u, c, w, mass, q, ws)
+    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                             !! particle masses
+    real(wp), intent(in), contiguous :: u(:,:)               !! particle vectors (ndim, np)
+    real(wp), intent(in) :: c                                !! scale of the second vector (0 to ignore it)
+    real(wp), intent(in), contiguous :: w(:,:)               !! second particle vectors (ndim, np)
+    real(wp), intent(inout), contiguous :: mass(:)           !! nodal masses (accumulated)
+    real(wp), intent(inout), contiguous :: q(:,:)            !! nodal vectors (ndim, nnode), accumulated
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
+    call p2g_drive(OP_MASS_MOMENTUM, basis, ws, m=m, u=u, c=c, w=w, mass=mass, q=q)
+  end subroutine p2g_mass_momentum
+
+  !> Internal force f_I −= Σ_p V_p σ_p ∇N_Ip (paper eq. 16), σ in Voigt order.
+  subroutine p2g_internal_force(basis, vol, stress, f, ws)
+    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
+    real(wp), intent(in) :: vol(:)                           !! particle volumes
+    real(wp), intent(in), contiguous :: stress(:,:)          !! Cauchy stress (6, np)
+    real(wp), intent(inout), contiguous :: f(:,:)            !! nodal forces (ndim, nnode), accumulated
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
+    call p2g_drive(OP_INTERNAL_FORCE, basis, ws, vol=vol, stress=stress, q=f)
+  end subroutine p2g_internal_force
+
+  !> External body force f_I += Σ_p N_Ip m_p (g + b_p) (paper eq. 17 without tractions).
+  subroutine p2g_body_force(basis, m, g, b, use_b, f, ws)
+    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                             !! particle masses
+    real(wp), intent(in) :: g(:)                             !! uniform acceleration (gravity) (ndim)
+    real(wp), intent(in) :: b(:,:)                           !! per-particle body force per unit mass (ndim, np)
+    logical, intent(in) :: use_b                             !! whether `b` holds data
+    real(wp), intent(inout), contiguous :: f(:,:)            !! nodal forces (ndim, nnode), accumulated
+    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
+    ! Nothing to add: skip the pass (adding zeros leaves f unchanged bit for bit).
+    if (.not. use_b .and. all(g == 0.0_wp)) return
+    call p2g_drive(OP_BODY_FORCE, basis, ws, m=m, g=g, b=b, use_b=use_b, q=f)
+  end subroutine p2g_body_force
+
+  !> The P2G skeleton of every `p2g_*` above: accumulate the sums `op` selects into `mass`
+  !> and/or `q`. Serial over all particles without a threaded workspace; otherwise each task
+  !> of each phase (module comment) sends its particle range to the target (dst = 0) or to its
+  !> chunk's buffers, and the buffers are reduced into the targets present. Only the
+  !> arguments `op` reads need be present.
+  subroutine p2g_drive(op, basis, ws, m, u, c, w, vol, stress, g, b, use_b, mass, q)
+    integer, intent(in) :: op                                       !! OP_* selector
+    type(empm_basis_t), intent(in) :: basis                         !! shape functions at the particles
+    type(empm_p2g_work_t), intent(inout), optional :: ws            !! threaded-P2G workspace
+    real(wp), intent(in), optional :: m(:)                          !! particle masses
+    real(wp), intent(in), optional, contiguous :: u(:,:)            !! particle vectors (ndim, np)
+    real(wp), intent(in), optional :: c                             !! scale of `w` (0 to ignore it)
+    real(wp), intent(in), optional, contiguous :: w(:,:)            !! second particle vectors (ndim, np)
+    real(wp), intent(in), optional :: vol(:)                        !! particle volumes
+    real(wp), intent(in), optional, contiguous :: stress(:,:)       !! Cauchy stress (6, np)
+    real(wp), intent(in), optional :: g(:)                          !! uniform acceleration (ndim)
+    real(wp), intent(in), optional :: b(:,:)                        !! body force per unit mass (ndim, np)
+    logical, intent(in), optional :: use_b                          !! whether `b` holds data
+    real(wp), intent(inout), optional, contiguous :: mass(:)        !! nodal scalars (accumulated)
+    real(wp), intent(inout), optional, contiguous :: q(:,:)         !! nodal vectors (ndim, nnode), accumulated
+    integer :: it, p0, p1, ph, dst
     if (.not. threaded(ws)) then
-      call mass_range(basis, m, 1, basis%np, mass); return
+      call p2g_range(op, basis, 1, basis%np, m, u, c, w, vol, stress, g, b, use_b, mass, q)
+      return
     end if
-    !$omp parallel num_threads(ws%nt) default(shared) private(ph, c, p0, p1, dst)
+    !$omp parallel num_threads(ws%nt) default(none) private(ph, it, p0, p1, dst) &
+    !$omp   shared(op, basis, ws, m, u, c, w, vol, stress, g, b, use_b, mass, q)
     do ph = 1, p2g_phases(ws)
       !$omp do schedule(static, 1)
-      do c = 1, ws%nt
-        call p2g_task(ws, basis%np, ph, c, p0, p1, dst)
+      do it = 1, ws%nt
+        call p2g_task(ws, basis%np, ph, it, p0, p1, dst)
         if (dst == 0) then
-          call mass_range(basis, m, p0, p1, mass)
+          call p2g_range(op, basis, p0, p1, m, u, c, w, vol, stress, g, b, use_b, mass, q)
         else
-          call mass_range(basis, m, p0, p1, ws%mbuf(:, dst))
+          call p2g_range(op, basis, p0, p1, m, u, c, w, vol, stress, g, b, use_b, &
+                         ws%mbuf(:, dst), ws%buf(:, :, dst))
         end if
       end do
       !$omp end do
     end do
-    call reduce_scalar(ws, mass)
+    if (present(mass)) call reduce_scalar(ws, mass)
+    if (present(q)) call reduce_vec(ws, q)
     !$omp end parallel
-  end subroutine p2g_mass
+  end subroutine p2g_drive
 
+  !> Particles p0..p1 of the P2G pass `op` into `mass` and/or `q`: the one dispatch on the
+  !> pass, once per particle range (never per particle).
+  pure subroutine p2g_range(op, basis, p0, p1, m, u, c, w, vol, stress, g, b, use_b, mass, q)
+    integer, intent(in) :: op                                       !! OP_* selector
+    type(empm_basis_t), intent(in) :: basis                         !! shape functions at the particles
+    integer, intent(in) :: p0                                       !! first particle
+    integer, intent(in) :: p1                                       !! last particle
+    real(wp), intent(in), optional :: m(:)                          !! particle masses
+    real(wp), intent(in), optional, contiguous :: u(:,:)            !! particle vectors (ndim, np)
+    real(wp), intent(in), optional :: c                             !! scale of `w` (0 to ignore it)
+    real(wp), intent(in), optional, contiguous :: w(:,:)            !! second particle vectors (ndim, np)
+    real(wp), intent(in), optional :: vol(:)                        !! particle volumes
+    real(wp), intent(in), optional, contiguous :: stress(:,:)       !! Cauchy stress (6, np)
+    real(wp), intent(in), optional :: g(:)                          !! uniform acceleration (ndim)
+    real(wp), intent(in), optional :: b(:,:)                        !! body force per unit mass (ndim, np)
+    logical, intent(in), optional :: use_b                          !! whether `b` holds data
+    real(wp), intent(inout), optional, contiguous :: mass(:)        !! nodal scalars (accumulated)
+    real(wp), intent(inout), optional, contiguous :: q(:,:)         !! nodal vectors (ndim, nnode), accumulated
+    select case (op)
+    case (OP_MASS)
+      call mass_range(basis, m, p0, p1, mass)
+    case (OP_WEIGHTED)
+      call weighted_range(basis, m, u, c, w, p0, p1, q)
+    case (OP_MASS_MOMENTUM)
+      call mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q)
+    case (OP_INTERNAL_FORCE)
+      call internal_range(basis, vol, stress, p0, p1, q)
+    case (OP_BODY_FORCE)
+      call body_range(basis, m, g, b, use_b, p0, p1, q)
+    end select
+  end subroutine p2g_range
+
+  !> m_I += Σ_p N_Ip m_p over particles p0..p1.
   pure subroutine mass_range(basis, m, p0, p1, mass)
-    type(empm_basis_t), intent(in) :: basis
-    real(wp), intent(in) :: m(:)
-    integer, intent(in) :: p0, p1
-    real(wp), intent(inout) :: mass(:)
+    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                     !! particle masses
+    integer, intent(in) :: p0                        !! first particle
+    integer, intent(in) :: p1                        !! last particle
+    real(wp), intent(inout) :: mass(:)               !! nodal masses (accumulated)
     integer :: p, k
     if (basis%layout == BASIS_Q4) then
       call mass_q4(basis%stride, p0, p1, basis%cell, basis%t, m, mass); return
@@ -234,42 +359,16 @@ contains
     end do
   end subroutine mass_range
 
-  !> Mass-weighted transfer q_I += Σ_p N_Ip m_p (u_p + c·w_p), e.g. momentum (c = 0) or the
-  !> predictor's v_p + (1−γ)Δt a_p.
-  subroutine p2g_weighted(basis, m, u, c, w, q, ws)
-    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
-    real(wp), intent(in) :: m(:)                             !! particle masses
-    real(wp), intent(in) :: u(:,:)                           !! particle vectors (ndim, np)
-    real(wp), intent(in) :: c                                !! scale of the second vector (0 to ignore it)
-    real(wp), intent(in) :: w(:,:)                           !! second particle vectors (ndim, np)
-    real(wp), intent(inout) :: q(:,:)                        !! nodal vectors (ndim, nnode), accumulated
-    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    integer :: ic, p0, p1, ph, dst
-    if (.not. threaded(ws)) then
-      call weighted_range(basis, m, u, c, w, 1, basis%np, q); return
-    end if
-    !$omp parallel num_threads(ws%nt) default(shared) private(ph, ic, p0, p1, dst)
-    do ph = 1, p2g_phases(ws)
-      !$omp do schedule(static, 1)
-      do ic = 1, ws%nt
-        call p2g_task(ws, basis%np, ph, ic, p0, p1, dst)
-        if (dst == 0) then
-          call weighted_range(basis, m, u, c, w, p0, p1, q)
-        else
-          call weighted_range(basis, m, u, c, w, p0, p1, ws%buf(:, :, dst))
-        end if
-      end do
-      !$omp end do
-    end do
-    call reduce_vec(ws, q)
-    !$omp end parallel
-  end subroutine p2g_weighted
-
+  !> q_I += Σ_p N_Ip m_p (u_p + c·w_p) over particles p0..p1.
   pure subroutine weighted_range(basis, m, u, c, w, p0, p1, q)
-    type(empm_basis_t), intent(in) :: basis
-    real(wp), intent(in) :: m(:), u(:,:), c, w(:,:)
-    integer, intent(in) :: p0, p1
-    real(wp), intent(inout) :: q(:,:)
+    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                     !! particle masses
+    real(wp), intent(in) :: u(:,:)                   !! particle vectors (ndim, np)
+    real(wp), intent(in) :: c                        !! scale of `w` (0 to ignore it)
+    real(wp), intent(in) :: w(:,:)                   !! second particle vectors (ndim, np)
+    integer, intent(in) :: p0                        !! first particle
+    integer, intent(in) :: p1                        !! last particle
+    real(wp), intent(inout) :: q(:,:)                !! nodal vectors (ndim, nnode), accumulated
     real(wp) :: mu(3)
     integer :: p, k, I, d
     if (basis%layout == BASIS_Q4) then
@@ -289,47 +388,17 @@ contains
     end do
   end subroutine weighted_range
 
-  !> Lumped mass and a mass-weighted vector in one pass over the particles:
-  !> m_I += Σ_p N_Ip m_p and q_I += Σ_p N_Ip m_p (u_p + c·w_p). The same sums as
-  !> [[p2g_mass]] followed by [[p2g_weighted]], bit for bit, reading the basis once.
-  subroutine p2g_mass_momentum(basis, m, u, c, w, mass, q, ws)
-    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
-    real(wp), intent(in) :: m(:)                             !! particle masses
-    real(wp), intent(in), contiguous :: u(:,:)               !! particle vectors (ndim, np)
-    real(wp), intent(in) :: c                                !! scale of the second vector (0 to ignore it)
-    real(wp), intent(in), contiguous :: w(:,:)               !! second particle vectors (ndim, np)
-    real(wp), intent(inout), contiguous :: mass(:)           !! nodal masses (accumulated)
-    real(wp), intent(inout), contiguous :: q(:,:)            !! nodal vectors (ndim, nnode), accumulated
-    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    integer :: ic, p0, p1, ph, dst
-    if (.not. threaded(ws)) then
-      call mass_momentum_range(basis, m, u, c, w, 1, basis%np, mass, q); return
-    end if
-    !$omp parallel num_threads(ws%nt) default(shared) private(ph, ic, p0, p1, dst)
-    do ph = 1, p2g_phases(ws)
-      !$omp do schedule(static, 1)
-      do ic = 1, ws%nt
-        call p2g_task(ws, basis%np, ph, ic, p0, p1, dst)
-        if (dst == 0) then
-          call mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q)
-        else
-          call mass_momentum_range(basis, m, u, c, w, p0, p1, ws%mbuf(:, dst), &
-                                   ws%buf(:, :, dst))
-        end if
-      end do
-      !$omp end do
-    end do
-    call reduce_scalar(ws, mass)
-    call reduce_vec(ws, q)
-    !$omp end parallel
-  end subroutine p2g_mass_momentum
-
+  !> [[mass_range]] and [[weighted_range]] in one pass over particles p0..p1 (the same bits).
   pure subroutine mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q)
-    type(empm_basis_t), intent(in) :: basis
-    real(wp), intent(in) :: m(:), c
-    real(wp), intent(in), contiguous :: u(:,:), w(:,:)
-    integer, intent(in) :: p0, p1
-    real(wp), intent(inout), contiguous :: mass(:), q(:,:)
+    type(empm_basis_t), intent(in) :: basis              !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                         !! particle masses
+    real(wp), intent(in), contiguous :: u(:,:)           !! particle vectors (ndim, np)
+    real(wp), intent(in) :: c                            !! scale of `w` (0 to ignore it)
+    real(wp), intent(in), contiguous :: w(:,:)           !! second particle vectors (ndim, np)
+    integer, intent(in) :: p0                            !! first particle
+    integer, intent(in) :: p1                            !! last particle
+    real(wp), intent(inout), contiguous :: mass(:)       !! nodal masses (accumulated)
+    real(wp), intent(inout), contiguous :: q(:,:)        !! nodal vectors (ndim, nnode), accumulated
     if (basis%layout == BASIS_Q4) then
       call mass_momentum_q4(basis%stride, p0, p1, basis%cell, basis%t, m, u, c, w, mass, q)
     else if (basis%ndim == 2) then
@@ -341,40 +410,14 @@ contains
     end if
   end subroutine mass_momentum_range
 
-  !> Internal force f_I −= Σ_p V_p σ_p ∇N_Ip (paper eq. 16), σ in Voigt order.
-  subroutine p2g_internal_force(basis, vol, stress, f, ws)
-    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
-    real(wp), intent(in) :: vol(:)                           !! particle volumes
-    real(wp), intent(in), contiguous :: stress(:,:)          !! Cauchy stress (6, np)
-    real(wp), intent(inout), contiguous :: f(:,:)            !! nodal forces (ndim, nnode), accumulated
-    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    integer :: c, p0, p1, ph, dst
-    if (.not. threaded(ws)) then
-      call internal_range(basis, vol, stress, 1, basis%np, f); return
-    end if
-    !$omp parallel num_threads(ws%nt) default(shared) private(ph, c, p0, p1, dst)
-    do ph = 1, p2g_phases(ws)
-      !$omp do schedule(static, 1)
-      do c = 1, ws%nt
-        call p2g_task(ws, basis%np, ph, c, p0, p1, dst)
-        if (dst == 0) then
-          call internal_range(basis, vol, stress, p0, p1, f)
-        else
-          call internal_range(basis, vol, stress, p0, p1, ws%buf(:, :, dst))
-        end if
-      end do
-      !$omp end do
-    end do
-    call reduce_vec(ws, f)
-    !$omp end parallel
-  end subroutine p2g_internal_force
-
+  !> f_I −= Σ_p V_p σ_p ∇N_Ip over particles p0..p1.
   pure subroutine internal_range(basis, vol, stress, p0, p1, f)
-    type(empm_basis_t), intent(in) :: basis
-    real(wp), intent(in) :: vol(:)
-    real(wp), intent(in), contiguous :: stress(:,:)
-    integer, intent(in) :: p0, p1
-    real(wp), intent(inout), contiguous :: f(:,:)
+    type(empm_basis_t), intent(in) :: basis              !! shape functions at the particles
+    real(wp), intent(in) :: vol(:)                       !! particle volumes
+    real(wp), intent(in), contiguous :: stress(:,:)      !! Cauchy stress (6, np)
+    integer, intent(in) :: p0                            !! first particle
+    integer, intent(in) :: p1                            !! last particle
+    real(wp), intent(inout), contiguous :: f(:,:)        !! nodal forces (ndim, nnode), accumulated
     real(wp) :: s(3, 3), t
     integer :: p, k, I, d, a, b
     d = basis%ndim
@@ -407,44 +450,16 @@ contains
     end do
   end subroutine internal_range
 
-  !> External body force f_I += Σ_p N_Ip m_p (g + b_p) (paper eq. 17 without tractions).
-  subroutine p2g_body_force(basis, m, g, b, use_b, f, ws)
-    type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
-    real(wp), intent(in) :: m(:)                             !! particle masses
-    real(wp), intent(in) :: g(:)                             !! uniform acceleration (gravity) (ndim)
-    real(wp), intent(in) :: b(:,:)                           !! per-particle body force per unit mass (ndim, np)
-    logical, intent(in) :: use_b                             !! whether `b` holds data
-    real(wp), intent(inout) :: f(:,:)                        !! nodal forces (ndim, nnode), accumulated
-    type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    integer :: c, p0, p1, ph, dst
-    ! Nothing to add: skip the pass (adding zeros leaves f unchanged bit for bit).
-    if (.not. use_b .and. all(g == 0.0_wp)) return
-    if (.not. threaded(ws)) then
-      call body_range(basis, m, g, b, use_b, 1, basis%np, f); return
-    end if
-    !$omp parallel num_threads(ws%nt) default(shared) private(ph, c, p0, p1, dst)
-    do ph = 1, p2g_phases(ws)
-      !$omp do schedule(static, 1)
-      do c = 1, ws%nt
-        call p2g_task(ws, basis%np, ph, c, p0, p1, dst)
-        if (dst == 0) then
-          call body_range(basis, m, g, b, use_b, p0, p1, f)
-        else
-          call body_range(basis, m, g, b, use_b, p0, p1, ws%buf(:, :, dst))
-        end if
-      end do
-      !$omp end do
-    end do
-    call reduce_vec(ws, f)
-    !$omp end parallel
-  end subroutine p2g_body_force
-
+  !> f_I += Σ_p N_Ip m_p (g + b_p) over particles p0..p1.
   pure subroutine body_range(basis, m, g, b, use_b, p0, p1, f)
-    type(empm_basis_t), intent(in) :: basis
-    real(wp), intent(in) :: m(:), g(:), b(:,:)
-    logical, intent(in) :: use_b
-    integer, intent(in) :: p0, p1
-    real(wp), intent(inout) :: f(:,:)
+    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
+    real(wp), intent(in) :: m(:)                     !! particle masses
+    real(wp), intent(in) :: g(:)                     !! uniform acceleration (ndim)
+    real(wp), intent(in) :: b(:,:)                   !! body force per unit mass (ndim, np)
+    logical, intent(in) :: use_b                     !! whether `b` holds data
+    integer, intent(in) :: p0                        !! first particle
+    integer, intent(in) :: p1                        !! last particle
+    real(wp), intent(inout) :: f(:,:)                !! nodal forces (ndim, nnode), accumulated
     real(wp) :: fp(3)
     integer :: p, k, I, d
     if (basis%layout == BASIS_Q4) then
@@ -469,7 +484,8 @@ contains
     real(wp), intent(out), contiguous :: u(:,:)      !! particle vectors (ndim, np)
     integer :: c, nc, p0, p1, p, k
     nc = empm_chunks(basis%np)
-    !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k) if(nc > 1)
+    !$omp parallel do num_threads(nc) schedule(static, 1) default(none) &
+    !$omp   shared(basis, q, u, nc) private(p0, p1, p, k) if(nc > 1)
     do c = 0, nc - 1
       call empm_chunk_bounds(basis%np, nc, c, p0, p1)
       if (basis%layout == BASIS_Q4) then
@@ -500,7 +516,8 @@ contains
     integer :: ic, nc, p0, p1, p, k, d
     d = basis%ndim
     nc = empm_chunks(basis%np)
-    !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, s) if(nc > 1)
+    !$omp parallel do num_threads(nc) schedule(static, 1) default(none) &
+    !$omp   shared(basis, c, q, u, nc, d) private(p0, p1, p, k, s) if(nc > 1)
     do ic = 0, nc - 1
       call empm_chunk_bounds(basis%np, nc, ic, p0, p1)
       if (basis%layout == BASIS_Q4) then
@@ -539,7 +556,9 @@ contains
     integer :: c, nc, p0, p1, p, k, I, d
     d = basis%ndim
     nc = empm_chunks(basis%np)
-    !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, p, k, I, sv, sa) if(nc > 1)
+    !$omp parallel do num_threads(nc) schedule(static, 1) default(none) &
+    !$omp   shared(basis, dt, g, vel, acc, x, v, a, nc, d) &
+    !$omp   private(p0, p1, p, k, I, sv, sa) if(nc > 1)
     do c = 0, nc - 1
       call empm_chunk_bounds(basis%np, nc, c, p0, p1)
       if (basis%layout == BASIS_Q4) then
@@ -617,7 +636,8 @@ contains
     if (nodes%ndim == 2) then
       call divide_2d(nodes%nnode, nodes%mass, nodes%mass_tol, q, out); return
     end if
-    !$omp parallel do schedule(static) private(d) if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
+    !$omp parallel do schedule(static) default(none) shared(nodes, q, out) private(d) &
+    !$omp   if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
     do I = 1, nodes%nnode
       if (nodes%mass(I) > nodes%mass_tol) then
         do d = 1, nodes%ndim
@@ -634,11 +654,14 @@ contains
 
   !> [[nodal_divide_by_mass]] in 2D (pairs in registers; the same divisions).
   subroutine divide_2d(n, mass, tol, q, out)
-    integer, intent(in) :: n
-    real(wp), intent(in) :: mass(n), tol, q(2, n)
-    real(wp), intent(out) :: out(2, n)
+    integer, intent(in) :: n             !! number of nodes
+    real(wp), intent(in) :: mass(n)      !! nodal masses
+    real(wp), intent(in) :: tol          !! empty-node mass threshold
+    real(wp), intent(in) :: q(2, n)      !! nodal vectors
+    real(wp), intent(out) :: out(2, n)   !! q/m
     integer :: I
-    !$omp parallel do schedule(static) if(n >= EMPM_OMP_MIN_PARTICLES)
+    !$omp parallel do schedule(static) default(none) shared(n, mass, tol, q, out) &
+    !$omp   if(n >= EMPM_OMP_MIN_PARTICLES)
     do I = 1, n
       if (mass(I) > tol) then
         out(:, I) = q(:, I) / mass(I)
@@ -661,9 +684,13 @@ contains
 
   !> v = vfix and mom = m vfix on the listed dofs (positions in the (ndim, nnode) arrays).
   pure subroutine constrain_dofs(n, dofs, nd, mass, vfix, v, mom)
-    integer, intent(in) :: n, dofs(n), nd
-    real(wp), intent(in) :: mass(*), vfix(*)
-    real(wp), intent(inout) :: v(*), mom(*)
+    integer, intent(in) :: n             !! number of fixed dofs
+    integer, intent(in) :: dofs(n)       !! fixed dofs (positions in the (nd, nnode) arrays)
+    integer, intent(in) :: nd            !! spatial dimension
+    real(wp), intent(in) :: mass(*)      !! nodal masses
+    real(wp), intent(in) :: vfix(*)      !! prescribed velocities (nd, nnode)
+    real(wp), intent(inout) :: v(*)      !! nodal velocities (nd, nnode)
+    real(wp), intent(inout) :: mom(*)    !! nodal momenta (nd, nnode)
     integer :: k, j
     do k = 1, n
       j = dofs(k)
@@ -681,8 +708,9 @@ contains
 
   !> f = 0 on the listed dofs.
   pure subroutine zero_dofs(n, dofs, f)
-    integer, intent(in) :: n, dofs(n)
-    real(wp), intent(inout) :: f(*)
+    integer, intent(in) :: n             !! number of fixed dofs
+    integer, intent(in) :: dofs(n)       !! fixed dofs (positions in the nodal array)
+    real(wp), intent(inout) :: f(*)      !! nodal forces (ndim, nnode)
     integer :: k
     do k = 1, n
       f(dofs(k)) = 0.0_wp

@@ -6,8 +6,8 @@
 !> Why: 2D linear runs are limited by memory traffic on two threads; the node lists with
 !> values and gradients (116 B per particle, written once and read by four passes) shrink to
 !> 20 B, and the fixed four-node loops need no node count or index loads. The values are the
-!> expressions of [[basis_q4_weights]], written out again in `weights` below so that the
-!> compiler inlines them (it does not inline across files), and every kernel does the same
+!> expressions of [[basis_q4_weights]], included from src/shape/empm_q4_weights.inc (one
+!> text, compiled into this file so that it is inlined), and every kernel does the same
 !> arithmetic in the same order as its node-list counterpart in [[empm_transfer_2d]] /
 !> [[empm_transfer]], so results are identical bit for bit (tests/unit/test_transfer_q4.pf
 !> checks both). Arrays are explicit-shape and contiguous; kernels work on particles p0..p1.
@@ -21,27 +21,8 @@ module empm_transfer_q4
 
 contains
 
-  !> Bilinear values at local coordinates (t1, t2) (as [[basis_q4_weights]]).
-  pure subroutine weights(t1, t2, N)
-    real(wp), intent(in) :: t1, t2
-    real(wp), intent(out) :: N(4)
-    real(wp) :: u1, u2
-    u1 = 1.0_wp - t1; u2 = 1.0_wp - t2
-    N(1) = u1 * u2; N(2) = t1 * u2; N(3) = u1 * t2; N(4) = t1 * t2
-  end subroutine weights
-
-  !> Bilinear gradients at (t1, t2) with 1/h = (h1, h2) (as [[basis_q4_weights]]); m1 = −h1
-  !> and m2 = −h2 are passed in, which gives the same bits: (−a)·b = −(a·b) exactly.
-  pure subroutine gradients(t1, t2, h1, h2, m1, m2, dN)
-    real(wp), intent(in) :: t1, t2, h1, h2, m1, m2
-    real(wp), intent(out) :: dN(2, 4)
-    real(wp) :: u1, u2
-    u1 = 1.0_wp - t1; u2 = 1.0_wp - t2
-    dN(1, 1) = m1 * u2; dN(2, 1) = u1 * m2
-    dN(1, 2) = h1 * u2; dN(2, 2) = t1 * m2
-    dN(1, 3) = m1 * t2; dN(2, 3) = u1 * h2
-    dN(1, 4) = h1 * t2; dN(2, 4) = t1 * h2
-  end subroutine gradients
+  ! q4_values and q4_gradients: the one text of the bilinear formulas (src/shape).
+  include '../shape/empm_q4_weights.inc'
 
   !> m_I += Σ N_Ip m_p.
   pure subroutine mass_q4(s, p0, p1, cell, t, m, mass)
@@ -56,7 +37,7 @@ contains
     integer :: p
     integer(int64) :: I, J ! 64-bit: the neighbours' addresses are offsets of I's
     do p = p0, p1
-      call weights(t(1, p), t(2, p), N)
+      call q4_values(t(1, p), t(2, p), N)
       I = cell(p); J = I + s
       mass(I) = mass(I) + N(1) * m(p)
       mass(I + 1) = mass(I + 1) + N(2) * m(p)
@@ -86,7 +67,7 @@ contains
       else
         mu = m(p) * (u(:, p) + c * w(:, p))
       end if
-      call weights(t(1, p), t(2, p), N)
+      call q4_values(t(1, p), t(2, p), N)
       I = cell(p); J = I + s
       q(:, I) = q(:, I) + N(1) * mu
       q(:, I + 1) = q(:, I + 1) + N(2) * mu
@@ -117,7 +98,7 @@ contains
       else
         mu = m(p) * (u(:, p) + c * w(:, p))
       end if
-      call weights(t(1, p), t(2, p), N)
+      call q4_values(t(1, p), t(2, p), N)
       I = cell(p); J = I + s
       mass(I) = mass(I) + N(1) * m(p);         q(:, I) = q(:, I) + N(1) * mu
       mass(I + 1) = mass(I + 1) + N(2) * m(p); q(:, I + 1) = q(:, I + 1) + N(2) * mu
@@ -145,7 +126,7 @@ contains
       fp = g
       if (use_b) fp = fp + b(:, p)
       fp = m(p) * fp
-      call weights(t(1, p), t(2, p), N)
+      call q4_values(t(1, p), t(2, p), N)
       I = cell(p); J = I + s
       f(:, I) = f(:, I) + N(1) * fp
       f(:, I + 1) = f(:, I + 1) + N(2) * fp
@@ -171,7 +152,7 @@ contains
     do p = p0, p1
       sx(1) = vol(p) * stress(1, p); sx(2) = vol(p) * stress(6, p)
       sy(1) = sx(2); sy(2) = vol(p) * stress(2, p)
-      call gradients(t(1, p), t(2, p), h(1), h(2), -h(1), -h(2), dN)
+      call q4_gradients(t(1, p), t(2, p), h(1), h(2), -h(1), -h(2), dN)
       I = cell(p); J = I + s
       f(:, I) = f(:, I) - (sx * dN(1, 1) + sy * dN(2, 1))
       f(:, I + 1) = f(:, I + 1) - (sx * dN(1, 2) + sy * dN(2, 2))
@@ -195,7 +176,7 @@ contains
     integer(int64) :: I, J ! 64-bit: the neighbours' addresses are offsets of I's
     !GCC$ novector
     do p = p0, p1
-      call gradients(t(1, p), t(2, p), h(1), h(2), -h(1), -h(2), dN)
+      call q4_gradients(t(1, p), t(2, p), h(1), h(2), -h(1), -h(2), dN)
       I = cell(p); J = I + s
       gx = 0.0_wp; gy = 0.0_wp
       gx = gx + v(:, I) * dN(1, 1);     gy = gy + v(:, I) * dN(2, 1)
@@ -221,7 +202,7 @@ contains
     integer :: p
     integer(int64) :: I, J ! 64-bit: the neighbours' addresses are offsets of I's
     do p = p0, p1
-      call weights(t(1, p), t(2, p), N)
+      call q4_values(t(1, p), t(2, p), N)
       I = cell(p); J = I + s
       sm = 0.0_wp
       sm = sm + N(1) * q(:, I)
@@ -256,7 +237,7 @@ contains
     ! The generic kernel's coefficients, formed in its evaluation order.
     cx = (g - 0.5_wp) * dt * dt; cv0 = (1.0_wp - g) * dt; cv1 = g * dt
     do p = p0, p1
-      call weights(t(1, p), t(2, p), N)
+      call q4_values(t(1, p), t(2, p), N)
       I = cell(p); J = I + s
       sv = 0.0_wp; sa = 0.0_wp
       sv = sv + N(1) * vel(:, I);     sa = sa + N(1) * acc(:, I)
