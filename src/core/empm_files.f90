@@ -2,9 +2,10 @@
 !> publish output files atomically and to create output folders.
 module empm_files
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+  use empm_error, only: empm_error_t, EMPM_ERR_IO
   implicit none
   private
-  public :: empm_rename, empm_remove, empm_mkdir_p
+  public :: empm_rename, empm_remove, empm_mkdir_p, empm_read_text
 
   interface
     function c_rename(old, new) bind(C, name='rename') result(r)
@@ -53,4 +54,31 @@ contains
     inquire(file=path//'/.', exist=there)
     info = merge(0, 1, there)
   end function empm_mkdir_p
+
+  !> The whole contents of the text file `path` (any line length). On failure `err` holds the
+  !> run-time library's message (code EMPM_ERR_IO) and `text` is empty.
+  subroutine empm_read_text(path, text, err)
+    character(len=*), intent(in) :: path               !! file to read
+    character(len=:), allocatable, intent(out) :: text !! its contents
+    type(empm_error_t), intent(inout) :: err           !! set on failure
+    integer :: u, ios, n
+    character(len=512) :: msg
+    text = ''
+    open(newunit=u, file=path, status='old', action='read', access='stream', &
+         form='unformatted', iostat=ios, iomsg=msg)
+    if (ios /= 0) then
+      call err%set(EMPM_ERR_IO, trim(msg)); return
+    end if
+    inquire(unit=u, size=n)
+    if (n > 0) then
+      deallocate(text)
+      allocate(character(len=n) :: text)
+      read(u, iostat=ios, iomsg=msg) text
+      if (ios /= 0) then
+        text = ''
+        call err%set(EMPM_ERR_IO, trim(msg))
+      end if
+    end if
+    close(u)
+  end subroutine empm_read_text
 end module empm_files
