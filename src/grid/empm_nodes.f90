@@ -1,6 +1,9 @@
 !> Nodal (grid) fields, rebuilt from the particles every step, and the Dirichlet constraints.
 module empm_nodes
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t, empm_raise_error, empm_alloc_error
+  use empm_strings, only: str
   use empm_grid, only: empm_grid_t
   implicit none
   private
@@ -32,17 +35,26 @@ module empm_nodes
 
 contains
 
-  !> Allocate nodal storage for `grid`; no dof fixed.
-  subroutine nodes_alloc(self, grid)
-    class(empm_nodes_t), intent(inout) :: self !! nodal fields
-    type(empm_grid_t), intent(in) :: grid      !! background grid
-    integer :: d, n
+  !> Allocate nodal storage for `grid`; no dof fixed. An allocation failure is reported in
+  !> `err` when present (with the memory asked for), otherwise it stops the program.
+  subroutine nodes_alloc(self, grid, err)
+    class(empm_nodes_t), intent(inout) :: self     !! nodal fields
+    type(empm_grid_t), intent(in) :: grid          !! background grid
+    type(empm_error_t), intent(inout), optional :: err !! set on an allocation failure
+    integer :: d, n, stat
+    character(len=256) :: msg
     d = grid%ndim; n = grid%nnode
     self%ndim = d; self%nnode = n
     if (allocated(self%mass)) deallocate(self%mass, self%mom, self%vel, self%force, self%acc, &
       self%work, self%fixed, self%vfix)
     allocate(self%mass(n), self%mom(d, n), self%vel(d, n), self%force(d, n), self%acc(d, n), &
-      self%work(d, n), self%fixed(d, n), self%vfix(d, n))
+      self%work(d, n), self%fixed(d, n), self%vfix(d, n), stat=stat, errmsg=msg)
+    if (stat /= 0) then
+      self%nnode = 0
+      call empm_raise_error(empm_alloc_error('nodal fields ('//str(n)//' nodes)', &
+        int(n, int64) * (8_int64 + 7_int64 * 8_int64 * d), msg), err)
+      return
+    end if
     self%fixed = .false.; self%vfix = 0.0_wp
     call self%list_fixed()
     call zero(self%mass, n); call zero(self%mom, d * n); call zero(self%vel, d * n)

@@ -2,9 +2,13 @@
 !> blocks shared by all schemes (basis evaluation, nodal forces, stress update).
 !>
 !> A scheme implements `step`, which advances the model by Δt. Adding a scheme means adding
-!> one file that extends [[empm_integrator_t]] and one line in [[empm_integrator_factory]].
+!> one file that extends [[empm_integrator_t]] and one line in [[empm_registry]].
 module empm_integrator
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t, empm_raise_error, empm_alloc_error
+  use empm_family, only: empm_family_t
+  use empm_namelist, only: empm_group_t
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_SHAPE_FAILED, &
                         STEP_MATERIAL_FAILED
   use empm_transfer, only: p2g_mass, p2g_mass_momentum, p2g_internal_force, p2g_body_force, &
@@ -20,14 +24,17 @@ module empm_integrator
   !> the L1 cache together.
   integer, parameter :: STRESS_BLOCK = 32
 
-  !> Abstract explicit integrator. Work arrays are allocated once in `prepare`.
-  type, abstract :: empm_integrator_t
+  !> Abstract explicit integrator. Work arrays are allocated once in `prepare`. A scheme names
+  !> itself (`family`, the registry name, also returned by `name`), may declare parameters
+  !> (`params`) and reads them from the `&integrator` group (`configure`).
+  type, abstract, extends(empm_family_t) :: empm_integrator_t
     real(wp), allocatable :: bwork(:,:)  !! body-force scratch (ndim, np)
     type(empm_p2g_work_t) :: p2g         !! per-thread P2G buffers (sized in `prepare`)
     type(empm_phase_timer_t) :: timer    !! wall time per phase of the step, Newton iterations
   contains
     procedure(step_iface), deferred :: step
-    procedure(name_iface), deferred :: name
+    procedure :: name => integrator_name
+    procedure :: configure => integrator_configure
     procedure :: prepare => integrator_prepare
     procedure :: start => integrator_start
     procedure :: assemble_forces
@@ -42,24 +49,44 @@ module empm_integrator
       real(wp), intent(in) :: dt                      !! time step [s]
       type(empm_step_status_t), intent(out) :: stat   !! outcome
     end subroutine step_iface
-
-    !> Scheme identifier, e.g. "usl", "musl".
-    function name_iface(self) result(s)
-      import :: empm_integrator_t
-      class(empm_integrator_t), intent(in) :: self !! integrator
-      character(len=:), allocatable :: s           !! identifier
-    end function name_iface
   end interface
 
 contains
 
+  !> Scheme identifier written to results, e.g. "usl": the registry name.
+  function integrator_name(self) result(s)
+    class(empm_integrator_t), intent(in) :: self !! integrator
+    character(len=:), allocatable :: s           !! identifier
+    s = self%family()
+  end function integrator_name
+
+  !> Read the scheme's parameters from the `&integrator` group; the default is for schemes
+  !> without parameters. A scheme with parameters reads each with `group%get(param, value,
+  !> err)`, which validates it against the declaration.
+  subroutine integrator_configure(self, group, err)
+    class(empm_integrator_t), intent(inout) :: self !! integrator
+    type(empm_group_t), intent(inout) :: group      !! the `&integrator` group
+    type(empm_error_t), intent(inout) :: err        !! set on invalid parameters
+    associate (unused_ => self, unused_group_ => group, unused_err_ => err); end associate
+  end subroutine integrator_configure
+
   !> Allocate work arrays for `model` and initialise the scheme's state (`start`). Call once,
   !> after the model's set-up, before stepping ([[empm_solve]] does).
-  subroutine integrator_prepare(self, model)
-    class(empm_integrator_t), intent(inout) :: self !! integrator
-    type(empm_model_t), intent(inout) :: model      !! simulation state
+  !> An allocation failure is reported in `err` when present (with the memory asked for),
+  !> otherwise it stops the program.
+  subroutine integrator_prepare(self, model, err)
+    class(empm_integrator_t), intent(inout) :: self     !! integrator
+    type(empm_model_t), intent(inout) :: model          !! simulation state
+    type(empm_error_t), intent(inout), optional :: err  !! set on an allocation failure
+    integer :: stat
+    character(len=256) :: msg
     if (allocated(self%bwork)) deallocate(self%bwork)
-    allocate(self%bwork(model%grid%ndim, model%pts%np))
+    allocate(self%bwork(model%grid%ndim, model%pts%np), stat=stat, errmsg=msg)
+    if (stat /= 0) then
+      call empm_raise_error(empm_alloc_error('integrator work arrays', &
+        8_int64 * model%grid%ndim * model%pts%np, msg), err)
+      return
+    end if
     self%bwork = 0.0_wp
     ! Threads are fixed here: P2G sums depend on the chunking, so it must not change mid-run.
     call self%p2g%init(model%grid%ndim, model%grid%nnode, model%pts%np, empm_max_threads())
@@ -171,7 +198,10 @@ contains
   !> the block, then V_p = m_p/ρ_p. L stays in the cache instead of making a round trip through
   !> memory. Blocks never straddle a run of particles sharing a material; with OpenMP each
   !> thread takes a contiguous slice of every run (particles are independent, so the result does
-  !> not depend on the thread count). On failure `stat` names the first failing particle.
+  !> not depend on the thread count). The material gets the block's whole state columns
+  !> `pts%state(:, q0:q1)` (contiguous, so passed without a copy; zero rows when no material
+  !> has state variables) and uses its own first rows. On failure `stat` names the first
+  !> failing particle.
   subroutine update_stress(model, vel, dt, stat)
     type(empm_model_t), intent(inout) :: model      !! simulation state
     real(wp), intent(in), contiguous :: vel(:,:)    !! nodal velocities defining L (ndim, nnode)
@@ -186,8 +216,8 @@ contains
       nc = empm_chunks(n)
       ! The first failing particle of the run, whichever block it is in.
       bad = huge(1)
-      !$omp parallel do schedule(static, 1) private(a, b, q0, q1, p, Lb, info) &
-      !$omp& reduction(min: bad) if(nc > 1)
+      !$omp parallel do default(none) schedule(static, 1) shared(model, vel, dt, i0, im, n, nc) &
+      !$omp& private(a, b, q0, q1, p, Lb, info) reduction(min: bad) if(nc > 1)
       do c = 0, nc - 1
         call empm_chunk_bounds(n, nc, c, a, b)
         a = a + i0 - 1; b = b + i0 - 1
@@ -196,7 +226,8 @@ contains
           q1 = min(b, q0 + STRESS_BLOCK - 1)
           call velocity_gradient(model%basis, vel, q0, q1, Lb)
           call model%mats(im)%model%update(dt, Lb(:, :, 1:q1 - q0 + 1), model%pts%F(:, :, q0:q1), &
-            model%pts%strain(:, q0:q1), model%pts%stress(:, q0:q1), model%pts%rho(q0:q1), info)
+            model%pts%strain(:, q0:q1), model%pts%stress(:, q0:q1), model%pts%state(:, q0:q1), &
+            model%pts%rho(q0:q1), info)
           if (info /= 0) bad = min(bad, q0 + info - 1)
           do p = q0, q1
             model%pts%vol(p) = model%pts%m(p) / model%pts%rho(p)

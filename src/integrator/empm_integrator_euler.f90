@@ -28,21 +28,33 @@ module empm_integrator_euler
     integer :: variant = EULER_MUSL !! EULER_USF, EULER_USL or EULER_MUSL
   contains
     procedure :: step => euler_step
-    procedure :: name => euler_name
+    procedure :: family => euler_family
+    procedure :: summary => euler_summary
   end type empm_euler_t
 
 contains
 
-  !> Identifier: "usf", "usl" or "musl".
-  function euler_name(self) result(s)
+  !> Registry name: "usf", "usl" or "musl".
+  pure function euler_family(self) result(s)
     class(empm_euler_t), intent(in) :: self !! integrator
-    character(len=:), allocatable :: s      !! identifier
+    character(len=:), allocatable :: s      !! name
     select case (self%variant)
     case (EULER_USF); s = 'usf'
     case (EULER_USL); s = 'usl'
     case default;     s = 'musl'
     end select
-  end function euler_name
+  end function euler_family
+
+  !> One-line description.
+  pure function euler_summary(self) result(s)
+    class(empm_euler_t), intent(in) :: self !! integrator
+    character(len=:), allocatable :: s      !! summary
+    select case (self%variant)
+    case (EULER_USF); s = 'forward Euler, update stress first'
+    case (EULER_USL); s = 'forward Euler, update stress last'
+    case default;     s = 'forward Euler, modified update stress last (velocities re-mapped)'
+    end select
+  end function euler_summary
 
   !> One forward-Euler step.
   subroutine euler_step(self, model, dt, stat)

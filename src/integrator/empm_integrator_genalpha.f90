@@ -10,6 +10,9 @@
 !> 5. L_p = Σ (Δu_I/Δt) ⊗ ∇N: the strain increment matches the displacement of step 4.
 module empm_integrator_genalpha
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t
+  use empm_params, only: empm_param_t, empm_param, PARAM_REAL
+  use empm_namelist, only: empm_group_t
   use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: p2g_weighted, g2p_add_scaled, g2p_value, &
@@ -25,7 +28,10 @@ module empm_integrator_genalpha
     real(wp) :: rho_b = 0.8_wp  !! spectral radius at infinite frequency, in [0, 1]
   contains
     procedure :: step => ga_step
-    procedure :: name => ga_name
+    procedure :: family => ga_family
+    procedure :: summary => ga_summary
+    procedure :: params => ga_params
+    procedure :: configure => ga_configure
     procedure :: start => ga_start
   end type empm_genalpha_t
 
@@ -42,14 +48,40 @@ contains
     gamma = 1.5_wp - alpha_m
   end subroutine genalpha_parameters
 
-  !> Identifier "gen_alpha".
-  function ga_name(self) result(s)
+  !> Registry name "gen_alpha".
+  pure function ga_family(self) result(s)
     class(empm_genalpha_t), intent(in) :: self !! integrator
-    character(len=:), allocatable :: s        !! identifier
-    associate (unused => self)
-    end associate
+    character(len=:), allocatable :: s        !! name
+    associate (unused_ => self); end associate
     s = 'gen_alpha'
-  end function ga_name
+  end function ga_family
+
+  !> One-line description.
+  pure function ga_summary(self) result(s)
+    class(empm_genalpha_t), intent(in) :: self !! integrator
+    character(len=:), allocatable :: s        !! summary
+    associate (unused_ => self); end associate
+    s = 'explicit generalized-alpha (Tran & Solowski 2019)'
+  end function ga_summary
+
+  !> Parameters: the spectral radius at infinite frequency ρ_b.
+  pure function ga_params(self) result(p)
+    class(empm_genalpha_t), intent(in) :: self !! integrator
+    type(empm_param_t), allocatable :: p(:)    !! declarations
+    associate (unused_ => self); end associate
+    p = [empm_param('rho_b', PARAM_REAL, '-', 'spectral radius at infinite frequency '// &
+      '(1: no numerical damping)', default='0.8', lo=0.0_wp, hi=1.0_wp)]
+  end function ga_params
+
+  !> Read ρ_b from the `&integrator` group.
+  subroutine ga_configure(self, group, err)
+    class(empm_genalpha_t), intent(inout) :: self !! integrator
+    type(empm_group_t), intent(inout) :: group    !! the `&integrator` group
+    type(empm_error_t), intent(inout) :: err      !! set on an invalid value
+    type(empm_param_t), allocatable :: p(:)
+    allocate(p, source=self%params())
+    call group%get(p(1), self%rho_b, err)
+  end subroutine ga_configure
 
   !> Initial particle accelerations.
   subroutine ga_start(self, model)

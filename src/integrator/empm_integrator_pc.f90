@@ -13,6 +13,9 @@
 !>                  x_p += Δt Σ N v*_I + (γ − ½)Δt² a_p, a_p = a⁺
 module empm_integrator_pc
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t
+  use empm_params, only: empm_param_t, empm_param, PARAM_REAL
+  use empm_namelist, only: empm_group_t
   use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: g2p_add_scaled, g2p_value, g2p_pc_newmark, &
@@ -31,22 +34,55 @@ module empm_integrator_pc
     real(wp) :: gamma = 0.5_wp       !! Newmark γ_N, in [0, 1]
   contains
     procedure :: step => pc_step
-    procedure :: name => pc_name
+    procedure :: family => pc_family
+    procedure :: summary => pc_summary
+    procedure :: params => pc_params
+    procedure :: configure => pc_configure
     procedure :: start => pc_start
   end type empm_pc_t
 
 contains
 
-  !> Identifier: "pc_published" or "pc_newmark".
-  function pc_name(self) result(s)
+  !> Registry name: "pc_published" or "pc_newmark".
+  pure function pc_family(self) result(s)
     class(empm_pc_t), intent(in) :: self !! integrator
-    character(len=:), allocatable :: s  !! identifier
+    character(len=:), allocatable :: s  !! name
     if (self%variant == PC_PUBLISHED) then
       s = 'pc_published'
     else
       s = 'pc_newmark'
     end if
-  end function pc_name
+  end function pc_family
+
+  !> One-line description.
+  pure function pc_summary(self) result(s)
+    class(empm_pc_t), intent(in) :: self !! integrator
+    character(len=:), allocatable :: s  !! summary
+    if (self%variant == PC_PUBLISHED) then
+      s = 'explicit predictor-corrector, particle update of eqs. (33)-(35) as published'
+    else
+      s = 'explicit predictor-corrector with the Newmark-consistent particle update'
+    end if
+  end function pc_summary
+
+  !> Parameters: the Newmark γ_N.
+  pure function pc_params(self) result(p)
+    class(empm_pc_t), intent(in) :: self     !! integrator
+    type(empm_param_t), allocatable :: p(:)  !! declarations
+    associate (unused_ => self); end associate
+    p = [empm_param('newmark_gamma', PARAM_REAL, '-', 'Newmark gamma_N of the predictor '// &
+      'and corrector (0.5: second order)', default='0.5', lo=0.0_wp, hi=1.0_wp)]
+  end function pc_params
+
+  !> Read γ_N from the `&integrator` group.
+  subroutine pc_configure(self, group, err)
+    class(empm_pc_t), intent(inout) :: self    !! integrator
+    type(empm_group_t), intent(inout) :: group !! the `&integrator` group
+    type(empm_error_t), intent(inout) :: err   !! set on an invalid value
+    type(empm_param_t), allocatable :: p(:)
+    allocate(p, source=self%params())
+    call group%get(p(1), self%gamma, err)
+  end subroutine pc_configure
 
   !> Initial particle accelerations (the predictor uses a_p).
   subroutine pc_start(self, model)

@@ -7,15 +7,20 @@
 !> is left as it is (identity) — updating it cost a third of the stress phase's memory traffic and
 !> nothing reads it.
 !>
-!> The module also holds what every isotropic elastic model shares: the parameter check
+!> The module also holds what every isotropic elastic model shares: the parameter declarations
+!> [[empm_elastic_params]] and their reader [[empm_elastic_read]], the parameter check
 !> [[empm_elastic_check]], the Lamé conversion [[empm_lame]] and the `MAT_*` status codes.
 module empm_material_linear_elastic
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t
+  use empm_params, only: empm_param_t, empm_param, PARAM_REAL
+  use empm_namelist, only: empm_group_t
   use empm_material, only: empm_material_t
   use empm_tensor, only: voigt_ddot
   implicit none
   private
   public :: empm_linear_elastic_t, empm_elastic_check, empm_lame
+  public :: empm_elastic_params, empm_elastic_read
   public :: MAT_OK, MAT_BAD_E, MAT_BAD_NU, MAT_BAD_RHO0
 
   integer, parameter :: MAT_OK = 0       !! parameters valid / update succeeded
@@ -31,13 +36,55 @@ module empm_material_linear_elastic
     real(wp) :: mu = 0.0_wp     !! shear modulus [Pa]
   contains
     procedure :: init => le_init
+    procedure :: configure => le_configure
+    procedure :: family => le_family
+    procedure :: summary => le_summary
+    procedure :: params => le_params
     procedure :: update => le_update
     procedure :: wave_speed => le_wave_speed
     procedure :: energy_density => le_energy_density
-    procedure :: name => le_name
   end type empm_linear_elastic_t
 
 contains
+
+  !> The parameters of an isotropic elastic model: `density`, `E`, `nu`.
+  pure function empm_elastic_params() result(p)
+    type(empm_param_t), allocatable :: p(:) !! declarations
+    p = [ &
+      empm_param('density', PARAM_REAL, 'kg/m3', 'initial density', lo=0.0_wp, lo_open=.true.), &
+      empm_param('E', PARAM_REAL, 'Pa', "Young's modulus", lo=0.0_wp, lo_open=.true.), &
+      empm_param('nu', PARAM_REAL, '-', "Poisson's ratio", default='0', lo=-1.0_wp, &
+        hi=0.5_wp, lo_open=.true., hi_open=.true.)]
+  end function empm_elastic_params
+
+  !> Read and validate `density`, `E` and `nu` ([[empm_elastic_params]]) from a `&material`
+  !> group; `err` names the key of the first missing or invalid one. The bounds are those of
+  !> [[empm_elastic_check]] (the reader rejects non-finite numbers).
+  subroutine empm_elastic_read(group, E, nu, rho0, err)
+    type(empm_group_t), intent(inout) :: group !! the `&material` group
+    real(wp), intent(out) :: E                 !! Young's modulus [Pa]
+    real(wp), intent(out) :: nu                !! Poisson's ratio [-]
+    real(wp), intent(out) :: rho0              !! reference density [kg/m³]
+    type(empm_error_t), intent(inout) :: err   !! set on a missing or invalid value
+    type(empm_param_t) :: p(3)
+    integer :: info
+    p = empm_elastic_params()
+    E = 0.0_wp; nu = 0.0_wp; rho0 = 0.0_wp
+    call group%get(p(1), rho0, err)
+    call group%get(p(2), E, err)
+    call group%get(p(3), nu, err)
+    if (err%code /= 0) return
+    ! The declarations already hold these bounds; the check keeps the two in step.
+    info = empm_elastic_check(E, nu, rho0)
+    select case (info)
+    case (MAT_BAD_E)
+      call group%fail(err, p(2)%name, "Young's modulus must be positive and finite")
+    case (MAT_BAD_NU)
+      call group%fail(err, p(3)%name, "Poisson's ratio must satisfy -1 < nu < 0.5")
+    case (MAT_BAD_RHO0)
+      call group%fail(err, p(1)%name, 'the density must be positive and finite')
+    end select
+  end subroutine empm_elastic_read
 
   !> Check isotropic elastic constants: `MAT_OK`, or the code of the first invalid one.
   !> NaN fails every test (comparisons with NaN are false), so it is rejected too.
@@ -80,20 +127,59 @@ contains
     call empm_lame(E, nu, self%lambda, self%mu)
   end subroutine le_init
 
+  !> Read `density`, `E` and `nu` from the `&material` group and set the constants.
+  subroutine le_configure(self, group, err)
+    class(empm_linear_elastic_t), intent(inout) :: self !! material
+    type(empm_group_t), intent(inout) :: group          !! the `&material` group
+    type(empm_error_t), intent(inout) :: err            !! set on a missing or invalid value
+    real(wp) :: E, nu, rho0
+    integer :: info
+    call empm_elastic_read(group, E, nu, rho0, err)
+    if (err%code /= 0) return
+    call self%init(E, nu, rho0, info)
+    if (info /= MAT_OK) call group%fail(err, '', 'invalid elastic constants') ! checked above
+  end subroutine le_configure
+
+  !> Registry name "linear_elastic".
+  pure function le_family(self) result(s)
+    class(empm_linear_elastic_t), intent(in) :: self !! material
+    character(len=:), allocatable :: s               !! "linear_elastic"
+    associate (unused_ => self); end associate
+    s = 'linear_elastic'
+  end function le_family
+
+  !> One-line description.
+  pure function le_summary(self) result(s)
+    class(empm_linear_elastic_t), intent(in) :: self !! material
+    character(len=:), allocatable :: s               !! summary
+    associate (unused_ => self); end associate
+    s = 'isotropic linear elasticity, small-strain hypoelastic update (the paper''s)'
+  end function le_summary
+
+  !> Parameters: `density`, `E`, `nu` ([[empm_elastic_params]]).
+  pure function le_params(self) result(p)
+    class(empm_linear_elastic_t), intent(in) :: self !! material
+    type(empm_param_t), allocatable :: p(:)          !! declarations
+    associate (unused_ => self); end associate
+    p = empm_elastic_params()
+  end function le_params
+
   !> Hypoelastic update of `n = size(rho)` particles (see the module notes).
   !> `info = k > 0`: 1 + tr Δε <= 0 at particle k (the first such), whose state is left
   !> unchanged (the other particles are updated); `info = -1`: array extents disagree with n.
-  pure subroutine le_update(self, dt, L, F, strain, stress, rho, info)
+  pure subroutine le_update(self, dt, L, F, strain, stress, state, rho, info)
     class(empm_linear_elastic_t), intent(in) :: self !! material
     real(wp), intent(in) :: dt                       !! time step [s]
     real(wp), intent(in), contiguous :: L(:,:,:)           !! velocity gradient (3,3,n) [1/s]
     real(wp), intent(inout), contiguous :: F(:,:,:)        !! deformation gradient (3,3,n), left unchanged
     real(wp), intent(inout), contiguous :: strain(:,:)     !! small strain, Voigt (6,n)
     real(wp), intent(inout), contiguous :: stress(:,:)     !! Cauchy stress, Voigt (6,n) [Pa]
+    real(wp), intent(inout), contiguous :: state(:,:)      !! state variables, none used
     real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
     integer, intent(out) :: info                     !! 0 ok; k > 0 particle k failed; −1 shapes
     real(wp) :: de(6), tr
     integer :: p, n
+    associate (unused_ => state); end associate
     info = 0
     n = size(rho)
     if (size(L, 3) /= n .or. size(F, 3) /= n .or. size(strain, 2) /= n &
@@ -130,13 +216,15 @@ contains
 
   !> Energy density ½ σ:ε per current volume (small strain: current ≈ reference volume).
   !> Exact for a stress built from zero by this model; F is not needed.
-  pure subroutine le_energy_density(self, F, strain, stress, psi)
+  pure subroutine le_energy_density(self, F, strain, stress, state, psi)
     class(empm_linear_elastic_t), intent(in) :: self !! material
     real(wp), intent(in) :: F(:,:,:)                 !! deformation gradient (3,3,n), unused
     real(wp), intent(in) :: strain(:,:)              !! small strain, Voigt (6,n)
     real(wp), intent(in) :: stress(:,:)              !! Cauchy stress, Voigt (6,n) [Pa]
+    real(wp), intent(in) :: state(:,:)               !! state variables, unused
     real(wp), intent(out) :: psi(:)                  !! ½ σ:ε (n) [J/m³]
     integer :: p
+    associate (unused_ => state); end associate
     ! Bound by every extent so that a short argument can never be read past its end.
     do p = 1, min(size(psi), size(strain, 2), size(stress, 2), size(F, 3))
       psi(p) = 0.5_wp * voigt_ddot(stress(:,p), strain(:,p))
@@ -144,13 +232,4 @@ contains
     associate (unused => self) ! the energy needs no material constant
     end associate
   end subroutine le_energy_density
-
-  !> Identifier "linear_elastic".
-  function le_name(self) result(s)
-    class(empm_linear_elastic_t), intent(in) :: self !! material
-    character(len=:), allocatable :: s               !! "linear_elastic"
-    associate (unused => self) ! the binding needs `self`; the name does not
-    end associate
-    s = 'linear_elastic'
-  end function le_name
 end module empm_material_linear_elastic

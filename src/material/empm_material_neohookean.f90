@@ -12,8 +12,12 @@
 !> The strain array receives sym(F) − I, for output only.
 module empm_material_neohookean
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t
+  use empm_params, only: empm_param_t
+  use empm_namelist, only: empm_group_t
   use empm_material, only: empm_material_t
-  use empm_material_linear_elastic, only: empm_elastic_check, empm_lame, MAT_OK
+  use empm_material_linear_elastic, only: empm_elastic_check, empm_lame, empm_elastic_params, &
+                                          empm_elastic_read, MAT_OK
   use empm_tensor, only: identity3, det3, mat_to_voigt, advance_f
   implicit none
   private
@@ -27,10 +31,13 @@ module empm_material_neohookean
     real(wp) :: mu = 0.0_wp     !! shear modulus [Pa]
   contains
     procedure :: init => nh_init
+    procedure :: configure => nh_configure
+    procedure :: family => nh_family
+    procedure :: summary => nh_summary
+    procedure :: params => nh_params
     procedure :: update => nh_update
     procedure :: wave_speed => nh_wave_speed
     procedure :: energy_density => nh_energy_density
-    procedure :: name => nh_name
   end type empm_neohookean_t
 
 contains
@@ -74,21 +81,61 @@ contains
     call empm_lame(E, nu, self%lambda, self%mu)
   end subroutine nh_init
 
+  !> Read `density`, `E` and `nu` (small-strain constants) from the `&material` group and set
+  !> the constants.
+  subroutine nh_configure(self, group, err)
+    class(empm_neohookean_t), intent(inout) :: self !! material
+    type(empm_group_t), intent(inout) :: group      !! the `&material` group
+    type(empm_error_t), intent(inout) :: err        !! set on a missing or invalid value
+    real(wp) :: E, nu, rho0
+    integer :: info
+    call empm_elastic_read(group, E, nu, rho0, err)
+    if (err%code /= 0) return
+    call self%init(E, nu, rho0, info)
+    if (info /= MAT_OK) call group%fail(err, '', 'invalid elastic constants') ! checked above
+  end subroutine nh_configure
+
+  !> Registry name "neohookean".
+  pure function nh_family(self) result(s)
+    class(empm_neohookean_t), intent(in) :: self !! material
+    character(len=:), allocatable :: s           !! "neohookean"
+    associate (unused_ => self); end associate
+    s = 'neohookean'
+  end function nh_family
+
+  !> One-line description.
+  pure function nh_summary(self) result(s)
+    class(empm_neohookean_t), intent(in) :: self !! material
+    character(len=:), allocatable :: s           !! summary
+    associate (unused_ => self); end associate
+    s = 'compressible neo-Hookean hyperelasticity (finite strain, total form)'
+  end function nh_summary
+
+  !> Parameters: `density`, `E`, `nu`, the small-strain constants ([[empm_elastic_params]]).
+  pure function nh_params(self) result(p)
+    class(empm_neohookean_t), intent(in) :: self !! material
+    type(empm_param_t), allocatable :: p(:)      !! declarations
+    associate (unused_ => self); end associate
+    p = empm_elastic_params()
+  end function nh_params
+
   !> Advance `n = size(rho)` particles (see the module notes).
   !> `info = k > 0`: det F <= 0 after the step at particle k (the first such), or already
   !> before it; that particle's state is left unchanged, the others are updated.
   !> `info = −1`: array extents disagree with n.
-  pure subroutine nh_update(self, dt, L, F, strain, stress, rho, info)
+  pure subroutine nh_update(self, dt, L, F, strain, stress, state, rho, info)
     class(empm_neohookean_t), intent(in) :: self !! material
     real(wp), intent(in) :: dt                   !! time step [s]
     real(wp), intent(in), contiguous :: L(:,:,:)           !! velocity gradient (3,3,n) [1/s]
     real(wp), intent(inout), contiguous :: F(:,:,:)        !! deformation gradient (3,3,n)
     real(wp), intent(inout), contiguous :: strain(:,:)     !! sym(F) − I on output, Voigt (6,n)
     real(wp), intent(inout), contiguous :: stress(:,:)     !! Cauchy stress, Voigt (6,n) [Pa]
+    real(wp), intent(inout), contiguous :: state(:,:)      !! state variables, none used
     real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
     integer, intent(out) :: info                 !! 0 ok; k > 0 particle k failed; −1 shapes
     real(wp) :: eye(3,3), Fn(3,3), J0, J1
     integer :: p, n
+    associate (unused_ => state); end associate
     info = 0
     n = size(rho)
     if (size(L, 3) /= n .or. size(F, 3) /= n .or. size(strain, 2) /= n &
@@ -124,14 +171,16 @@ contains
 
   !> Energy per current volume ψ₀(F)/J from F alone. A particle with det F <= 0 (never produced
   !> by the update) gets huge(), the limit of ψ as J → 0⁺.
-  pure subroutine nh_energy_density(self, F, strain, stress, psi)
+  pure subroutine nh_energy_density(self, F, strain, stress, state, psi)
     class(empm_neohookean_t), intent(in) :: self !! material
     real(wp), intent(in) :: F(:,:,:)             !! deformation gradient (3,3,n)
     real(wp), intent(in) :: strain(:,:)          !! small strain (6,n), unused
     real(wp), intent(in) :: stress(:,:)          !! Cauchy stress (6,n), unused
+    real(wp), intent(in) :: state(:,:)           !! state variables, unused
     real(wp), intent(out) :: psi(:)              !! ψ₀/J (n) [J/m³]
     real(wp) :: J
     integer :: p
+    associate (unused_ => state); end associate
     ! Bound by every extent so that a short argument can never be read past its end.
     do p = 1, min(size(psi), size(F, 3), size(strain, 2), size(stress, 2))
       J = det3(F(:,:,p))
@@ -142,13 +191,4 @@ contains
       end if
     end do
   end subroutine nh_energy_density
-
-  !> Identifier "neohookean".
-  function nh_name(self) result(s)
-    class(empm_neohookean_t), intent(in) :: self !! material
-    character(len=:), allocatable :: s           !! "neohookean"
-    associate (unused => self) ! the binding needs `self`; the name does not
-    end associate
-    s = 'neohookean'
-  end function nh_name
 end module empm_material_neohookean

@@ -19,6 +19,8 @@ module empm_history
     real(wp), allocatable :: m(:)        !! masses (np)
     real(wp), allocatable :: vol(:)      !! volumes (np)
     real(wp), allocatable :: rho(:)      !! densities (np)
+    real(wp), allocatable :: state(:,:)  !! materials' state variables (nstate, np), as
+                                         !! `pts%state`
   end type empm_snapshot_t
 
   !> Histories of a run.
@@ -101,7 +103,8 @@ contains
     call move_alloc(r3, self%ps)
   end subroutine grow
 
-  !> Store a snapshot of the particle state (ignored beyond the reserved count).
+  !> Store a snapshot of the particle state, state variables included (ignored beyond the
+  !> reserved count).
   subroutine history_add_snapshot(self, t, step, pts)
     class(empm_history_t), intent(inout) :: self !! record
     real(wp), intent(in) :: t                    !! time [s]
@@ -114,5 +117,6 @@ contains
     self%snap(k)%x = pts%x(:, 1:n); self%snap(k)%v = pts%v(:, 1:n)
     self%snap(k)%stress = pts%stress(:, 1:n); self%snap(k)%strain = pts%strain(:, 1:n)
     self%snap(k)%m = pts%m(1:n); self%snap(k)%vol = pts%vol(1:n); self%snap(k)%rho = pts%rho(1:n)
+    self%snap(k)%state = pts%state(:, 1:n)
   end subroutine history_add_snapshot
 end module empm_history

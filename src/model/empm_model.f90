@@ -1,12 +1,15 @@
 !> The state of one MPM simulation: grid, nodal fields, particles, basis, shape family,
 !> materials and loads. No global state: everything a step needs lives here.
 module empm_model
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t, empm_alloc_error, empm_raise_error, EMPM_ERR_USAGE
+  use empm_strings, only: str
   use empm_grid, only: empm_grid_t
   use empm_nodes, only: empm_nodes_t
   use empm_particles, only: empm_particles_t
   use empm_shape, only: empm_shape_t, empm_basis_t
-  use empm_material, only: empm_material_t
+  use empm_material, only: empm_material_t, STATE_NAME_LEN
   use empm_loads, only: empm_loads_t
   implicit none
   private
@@ -50,10 +53,18 @@ module empm_model
 contains
 
   !> Prepare the derived data once particles, grid, shape and materials are set: basis storage,
-  !> nodal storage, material runs and the empty-node mass threshold. Call before stepping.
-  subroutine model_finalize_setup(self)
-    class(empm_model_t), intent(inout) :: self !! model
-    integer :: p, nrun, np
+  !> nodal storage, material runs, the empty-node mass threshold, and the particles' state
+  !> variables (as many rows as the most demanding material needs, each material's particles
+  !> initialised by its `init_state`). Call before stepping; calling it again re-initialises
+  !> the state variables. Errors (a material whose `state_names` disagree with `nstate`, a
+  !> particle without a material, out of memory) go to `err` when present, which never stops
+  !> the program; otherwise they are printed and the program stops.
+  subroutine model_finalize_setup(self, err)
+    class(empm_model_t), intent(inout) :: self          !! model
+    type(empm_error_t), intent(inout), optional :: err  !! set-up error, if present
+    type(empm_error_t) :: e
+    integer :: p, nrun, np, nsmax, im, r, ns, st
+    character(len=256) :: msg
     np = self%pts%np
     ! Keep constraints set earlier with nodes%fix_box.
     if (.not. allocated(self%nodes%mass) .or. self%nodes%nnode /= self%grid%nnode) &
@@ -70,8 +81,15 @@ contains
         nrun = nrun + 1
       end if
     end do
-    if (allocated(self%run_first)) deallocate(self%run_first, self%run_last)
-    allocate(self%run_first(nrun), self%run_last(nrun))
+    if (allocated(self%run_first)) deallocate(self%run_first)
+    if (allocated(self%run_last)) deallocate(self%run_last)
+    st = 0; msg = ''
+    allocate(self%run_first(nrun), self%run_last(nrun), stat=st, errmsg=msg)
+    if (st /= 0) then
+      call empm_raise_error(empm_alloc_error('material runs ('//str(nrun)//')', &
+        8_int64 * nrun, trim(msg)), err)
+      return
+    end if
     nrun = 0
     do p = 1, np
       if (p == 1) then
@@ -86,5 +104,69 @@ contains
     if (np > 0) then
       self%nodes%mass_tol = 1.0e-10_wp * minval(self%pts%m(1:np))
     end if
+
+    ! State variables: rows for the most demanding material, then each run's initial values.
+    nsmax = 0
+    if (allocated(self%mats)) then
+      do im = 1, size(self%mats)
+        if (.not. allocated(self%mats(im)%model)) cycle
+        call check_state_names(self%mats(im)%model, im, e)
+        if (e%code /= 0) then
+          call empm_raise_error(e, err); return
+        end if
+        nsmax = max(nsmax, self%mats(im)%model%nstate())
+      end do
+    end if
+    if (.not. allocated(self%pts%state) .or. self%pts%nstate /= nsmax) then
+      call self%pts%set_nstate(nsmax, e)
+      if (e%code /= 0) then
+        call empm_raise_error(e, err); return
+      end if
+    else
+      self%pts%state = 0.0_wp ! rows a material does not own stay zero
+    end if
+    if (nsmax == 0) return
+    do r = 1, nrun
+      im = self%pts%mat(self%run_first(r))
+      if (im < 1 .or. im > size(self%mats)) then
+        call e%set(EMPM_ERR_USAGE, 'particle '//str(self%run_first(r))//' has material '// &
+          str(im)//', but the model has '//str(size(self%mats))//' materials')
+        call empm_raise_error(e, err); return
+      end if
+      if (.not. allocated(self%mats(im)%model)) then
+        call e%set(EMPM_ERR_USAGE, 'material '//str(im)//' is not allocated')
+        call empm_raise_error(e, err); return
+      end if
+      ns = self%mats(im)%model%nstate()
+      if (ns > 0) call self%mats(im)%model%init_state( &
+        self%pts%state(1:ns, self%run_first(r):self%run_last(r)))
+    end do
   end subroutine model_finalize_setup
+
+  !> A material's state variables must have as many names as `nstate`, each made of letters,
+  !> digits and '_' (they name HDF5 datasets and XDMF attributes), without repeats.
+  subroutine check_state_names(mat, im, e)
+    class(empm_material_t), intent(in) :: mat
+    integer, intent(in) :: im
+    type(empm_error_t), intent(inout) :: e
+    character(len=STATE_NAME_LEN), allocatable :: names(:)
+    character(len=*), parameter :: OK = &
+      'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_'
+    integer :: k
+    call mat%state_names(names)
+    if (size(names) /= mat%nstate()) then
+      call e%set(EMPM_ERR_USAGE, 'material '//str(im)//' ('//mat%name()//') declares '// &
+        str(mat%nstate())//' state variables but names '//str(size(names)))
+      return
+    end if
+    do k = 1, size(names)
+      if (len_trim(names(k)) == 0 .or. verify(trim(names(k)), OK) > 0 .or. &
+          any(names(1:k - 1) == names(k))) then
+        call e%set(EMPM_ERR_USAGE, 'material '//str(im)//' ('//mat%name()//'): state '// &
+          'variable name '''//trim(names(k))//''' must be unique and made of letters, '// &
+          'digits and _')
+        return
+      end if
+    end do
+  end subroutine check_state_names
 end module empm_model

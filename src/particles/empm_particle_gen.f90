@@ -4,6 +4,7 @@ module empm_particle_gen
   use empm_kinds, only: wp
   use empm_grid, only: empm_grid_t
   use empm_particles, only: empm_particles_t
+  use empm_error, only: empm_error_t
   implicit none
   private
   public :: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
@@ -18,8 +19,9 @@ contains
   !> Append the particles of one body. A candidate point (Gauss or voxel position of a grid
   !> cell) is kept when it lies inside the geometry; its volume is the cell volume times its
   !> quadrature weight share, and its half-length is half the voxel size (used by uGIMP).
+  !> The particles' state variables start at zero (the model's set-up initialises them).
   subroutine empm_fill(pts, grid, geom, lo, hi, center, radius, ppc, placement, rho, mat, &
-                       nadded, info)
+                       nadded, info, err)
     type(empm_particles_t), intent(inout) :: pts !! particle set (appended to)
     type(empm_grid_t), intent(in) :: grid        !! background grid
     integer, intent(in) :: geom                  !! GEOM_BOX or GEOM_DISK
@@ -31,7 +33,11 @@ contains
     real(wp), intent(in) :: rho                  !! density [kg/m³]
     integer, intent(in) :: mat                   !! material index
     integer, intent(out) :: nadded               !! particles added
-    integer, intent(out) :: info                 !! 0 ok, 1 bad ppc, 2 bad geometry/placement
+    integer, intent(out) :: info                 !! 0 ok, 1 bad ppc, 2 bad geometry/placement,
+                                                 !! 3 out of memory (with `err`)
+    type(empm_error_t), intent(inout), optional :: err !! allocation failure when the storage
+                                                       !! grows; without it the program stops
+    type(empm_error_t) :: e
     real(wp) :: xi(4), wi(4), x(3), lp(3), w, cellvol
     integer :: d, nd, c(3), s(3), cmax(3), k, c1, c2, c3
     logical :: inside
@@ -70,7 +76,14 @@ contains
               inside = sum((x(1:nd) - center(1:nd))**2) <= radius**2
             end if
             if (inside) then
-              call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat)
+              if (present(err)) then
+                call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat, e)
+                if (e%code /= 0) then
+                  err = e; info = 3; return
+                end if
+              else
+                call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat)
+              end if
               nadded = nadded + 1
             end if
           end do

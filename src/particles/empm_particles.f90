@@ -2,8 +2,14 @@
 !>
 !> Every per-particle quantity is a contiguous array whose last index is the particle.
 !> Tensors use Voigt order (xx, yy, zz, yz, xz, xy) with tensor (not engineering) shear strains.
+!> The materials' state variables are `state(nstate, np)`: nstate rows for every particle (the
+!> largest count over the materials; the model sets it), whatever each row means to the
+!> particle's material.
 module empm_particles
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t, empm_alloc_error, empm_raise_error
+  use empm_strings, only: str
   implicit none
   private
   public :: empm_particles_t
@@ -29,45 +35,121 @@ module empm_particles
     real(wp), allocatable :: lam_old(:,:)   !! its value one evaluation earlier (LME extrapolation;
                                             !! huge = no history yet)
     integer, allocatable :: mat(:)          !! material index (np)
+    integer :: nstate = 0                   !! state variables per particle (rows of `state`)
+    real(wp), allocatable :: state(:,:)     !! materials' state variables (nstate, np)
   contains
     procedure :: alloc => particles_alloc
+    procedure :: set_nstate => particles_set_nstate
     procedure :: append => particles_append
     procedure :: copy_state_from => particles_copy_state
   end type empm_particles_t
 
 contains
 
-  !> Allocate storage for `capacity` particles and set `np = 0`.
-  subroutine particles_alloc(self, ndim, capacity)
-    class(empm_particles_t), intent(inout) :: self !! particle set
-    integer, intent(in) :: ndim                    !! spatial dimension
-    integer, intent(in) :: capacity                !! number of particles to reserve
-    integer :: n
+  !> Allocate storage for `capacity` particles and set `np = 0`. On an allocation failure the
+  !> set is left empty and unallocated, and the error says how much memory was asked for: in
+  !> `err` when present (the program never stops then), otherwise on stderr before stopping.
+  subroutine particles_alloc(self, ndim, capacity, nstate, err)
+    class(empm_particles_t), intent(inout) :: self          !! particle set
+    integer, intent(in) :: ndim                             !! spatial dimension
+    integer, intent(in) :: capacity                         !! number of particles to reserve
+    integer, intent(in), optional :: nstate                 !! state variables per particle
+                                                            !! (default 0)
+    type(empm_error_t), intent(inout), optional :: err      !! allocation failure, if present
+    integer :: n, ns, st
+    integer(int64) :: bytes
+    character(len=256) :: msg
     n = max(capacity, 0)
+    ns = 0
+    if (present(nstate)) ns = max(nstate, 0)
     self%ndim = ndim
     self%np = 0
-    if (allocated(self%x)) deallocate(self%x, self%x0, self%v, self%a, self%m, self%vol, self%vol0, &
-      self%rho, self%stress, self%strain, self%F, self%lp, self%lam, self%lam_old, self%mat)
+    self%nstate = ns
+    call release(self)
+    st = 0; msg = ''
     allocate(self%x(ndim, n), self%x0(ndim, n), self%v(ndim, n), self%a(ndim, n), &
       self%m(n), self%vol(n), self%vol0(n), self%rho(n), self%stress(6, n), self%strain(6, n), &
       self%F(3, 3, n), self%lp(ndim, n), self%lam(ndim, n), &
-      self%lam_old(ndim, n), self%mat(n))
+      self%lam_old(ndim, n), self%mat(n), self%state(ns, n), stat=st, errmsg=msg)
+    if (st /= 0) then
+      call release(self)
+      ! 7 vectors, 4 scalars, 2 Voigt tensors, F and the state in reals; the material index.
+      bytes = int(n, int64) * (8_int64 * (7 * ndim + 4 + 12 + 9 + int(ns, int64)) + 4_int64)
+      call empm_raise_error(empm_alloc_error('particle storage ('//str(n)//' particles)', &
+        bytes, trim(msg)), err)
+    end if
   end subroutine particles_alloc
 
-  !> Append one particle at rest, unstressed, with identity deformation gradient.
-  !> Grows the storage geometrically when full (set-up only, never in the time loop).
-  subroutine particles_append(self, x, vol, rho, lp, mat)
-    class(empm_particles_t), intent(inout) :: self !! particle set
-    real(wp), intent(in) :: x(:)                   !! position (ndim)
-    real(wp), intent(in) :: vol                    !! volume [m³]
-    real(wp), intent(in) :: rho                    !! density [kg/m³]
-    real(wp), intent(in) :: lp(:)                  !! half-lengths of the particle domain (ndim)
-    integer, intent(in) :: mat                     !! material index
+  !> Give every particle `nstate` state variables, all zero (set-up; the model calls it with
+  !> the largest count over its materials, then lets each material set its particles' values).
+  !> Allocation failures are reported as in [[particles_alloc]].
+  subroutine particles_set_nstate(self, nstate, err)
+    class(empm_particles_t), intent(inout) :: self          !! particle set (allocated)
+    integer, intent(in) :: nstate                           !! state variables per particle
+    type(empm_error_t), intent(inout), optional :: err      !! allocation failure, if present
+    integer :: n, st
+    character(len=256) :: msg
+    n = 0
+    if (allocated(self%m)) n = size(self%m)
+    self%nstate = max(nstate, 0)
+    if (allocated(self%state)) deallocate(self%state)
+    st = 0; msg = ''
+    allocate(self%state(self%nstate, n), stat=st, errmsg=msg)
+    if (st /= 0) then
+      call empm_raise_error(empm_alloc_error('particle state variables ('//str(self%nstate)// &
+        ' x '//str(n)//')', 8_int64 * self%nstate * n, trim(msg)), err)
+      return
+    end if
+    self%state = 0.0_wp
+  end subroutine particles_set_nstate
+
+  !> Deallocate whatever is allocated (a failed allocate may leave some arrays allocated).
+  subroutine release(self)
+    class(empm_particles_t), intent(inout) :: self
+    if (allocated(self%x)) deallocate(self%x)
+    if (allocated(self%x0)) deallocate(self%x0)
+    if (allocated(self%v)) deallocate(self%v)
+    if (allocated(self%a)) deallocate(self%a)
+    if (allocated(self%m)) deallocate(self%m)
+    if (allocated(self%vol)) deallocate(self%vol)
+    if (allocated(self%vol0)) deallocate(self%vol0)
+    if (allocated(self%rho)) deallocate(self%rho)
+    if (allocated(self%stress)) deallocate(self%stress)
+    if (allocated(self%strain)) deallocate(self%strain)
+    if (allocated(self%F)) deallocate(self%F)
+    if (allocated(self%lp)) deallocate(self%lp)
+    if (allocated(self%lam)) deallocate(self%lam)
+    if (allocated(self%lam_old)) deallocate(self%lam_old)
+    if (allocated(self%mat)) deallocate(self%mat)
+    if (allocated(self%state)) deallocate(self%state)
+  end subroutine release
+
+  !> Append one particle at rest, unstressed, with identity deformation gradient and zero
+  !> state variables. Grows the storage geometrically when full (set-up only, never in the time
+  !> loop). On an allocation failure nothing is appended and the error is reported as in
+  !> [[particles_alloc]].
+  subroutine particles_append(self, x, vol, rho, lp, mat, err)
+    class(empm_particles_t), intent(inout) :: self     !! particle set
+    real(wp), intent(in) :: x(:)                       !! position (ndim)
+    real(wp), intent(in) :: vol                        !! volume [m³]
+    real(wp), intent(in) :: rho                        !! density [kg/m³]
+    real(wp), intent(in) :: lp(:)                      !! half-lengths of the particle domain (ndim)
+    integer, intent(in) :: mat                         !! material index
+    type(empm_error_t), intent(inout), optional :: err !! allocation failure, if present
     type(empm_particles_t) :: tmp
+    type(empm_error_t) :: e
     integer :: n, d
-    if (.not. allocated(self%x)) call self%alloc(size(x), 64)
+    if (.not. allocated(self%x)) then
+      call self%alloc(size(x), 64, err=e)
+      if (e%code /= 0) then
+        call empm_raise_error(e, err); return
+      end if
+    end if
     if (self%np == size(self%m)) then
-      call tmp%alloc(self%ndim, 2 * size(self%m))
+      call tmp%alloc(self%ndim, 2 * size(self%m), self%nstate, e)
+      if (e%code /= 0) then
+        call empm_raise_error(e, err); return
+      end if
       call tmp%copy_state_from(self)
       call move_alloc_all(tmp, self)
     end if
@@ -83,15 +165,21 @@ contains
     ! lam_old = huge: no history yet (see the LME warm-start extrapolation).
     self%lp(:, n) = lp(1:d); self%lam(:, n) = 0.0_wp; self%lam_old(:, n) = huge(1.0_wp)
     self%mat(n) = mat
+    self%state(:, n) = 0.0_wp
   end subroutine particles_append
 
-  !> Copy the first `src%np` particles of `src` into `self` (which must be large enough).
+  !> Copy the first `src%np` particles of `src` into `self` (which must be large enough), state
+  !> variables included. The destination takes the source's number of state variables: its
+  !> state array is reallocated when that differs, so a copy allocated with [[particles_alloc]]
+  !> alone (no `nstate`) works; the next copies then allocate nothing.
   subroutine particles_copy_state(self, src)
     class(empm_particles_t), intent(inout) :: self !! destination (allocated, capacity >= src%np)
     class(empm_particles_t), intent(in) :: src     !! source
     integer :: n
     n = src%np
     self%np = n
+    if (size(self%state, 1) /= src%nstate) call self%set_nstate(src%nstate)
+    if (src%nstate > 0) self%state(:, 1:n) = src%state(:, 1:n)
     self%x(:, 1:n) = src%x(:, 1:n); self%x0(:, 1:n) = src%x0(:, 1:n)
     self%v(:, 1:n) = src%v(:, 1:n); self%a(:, 1:n) = src%a(:, 1:n)
     self%m(1:n) = src%m(1:n); self%vol(1:n) = src%vol(1:n); self%vol0(1:n) = src%vol0(1:n)
@@ -116,5 +204,7 @@ contains
     call move_alloc(from%lp, to%lp); call move_alloc(from%lam, to%lam)
     call move_alloc(from%lam_old, to%lam_old)
     call move_alloc(from%mat, to%mat)
+    to%nstate = from%nstate
+    call move_alloc(from%state, to%state)
   end subroutine move_alloc_all
 end module empm_particles

@@ -4,9 +4,14 @@
 !> A family implements two deferred procedures: `eval_point` (one point, for tests and for
 !> embedding codes) and `eval_batch` (all particles, called once per step so that polymorphic
 !> dispatch happens once per batch, not per particle). Adding a family means adding one file
-!> that extends [[empm_shape_t]] and one line in [[empm_shape_factory]].
+!> that extends [[empm_shape_t]] and one line in [[empm_registry]].
 module empm_shape
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t, empm_raise_error, empm_alloc_error
+  use empm_strings, only: str
+  use empm_family, only: empm_family_t
+  use empm_namelist, only: empm_group_t
   use empm_grid, only: empm_grid_t
   use empm_particles, only: empm_particles_t
   implicit none
@@ -57,8 +62,11 @@ module empm_shape
     procedure :: get => basis_get
   end type empm_basis_t
 
-  !> Abstract shape-function family.
-  type, abstract :: empm_shape_t
+  !> Abstract shape-function family. Besides the deferred procedures, a family names itself
+  !> (`family`, the registry name, and `name`, the identifier of a configured instance written
+  !> to results, e.g. "lme_g0.8"), may declare parameters (`params`) and read them from the
+  !> `&shape` group (`configure`), and says how many padding cells a body needs (`padding_cells`).
+  type, abstract, extends(empm_family_t) :: empm_shape_t
     integer :: ndim = 0 !! spatial dimension the instance was set up for
   contains
     procedure(max_nodes_iface), deferred :: max_nodes
@@ -67,6 +75,8 @@ module empm_shape
     procedure(name_iface), deferred :: name
     procedure :: eval_batch_iters => shape_eval_batch_iters
     procedure :: layout => shape_layout
+    procedure :: configure => shape_configure
+    procedure :: padding_cells => shape_padding_cells
   end type empm_shape_t
 
   abstract interface
@@ -128,6 +138,29 @@ contains
     iters = 0
   end subroutine shape_eval_batch_iters
 
+  !> Read the family's parameters from the `&shape` group `group` (the registry sets `ndim`
+  !> first; `grid` is the model's grid). The default is for families without parameters:
+  !> nothing to read. A family with parameters reads each with `group%get(param, value, err)`
+  !> (which validates it against the declaration) and checks combinations itself, reporting
+  !> problems with `group%fail(err, key, text)`.
+  subroutine shape_configure(self, grid, group, err)
+    class(empm_shape_t), intent(inout) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid      !! background grid
+    type(empm_group_t), intent(inout) :: group !! the `&shape` group (possibly empty)
+    type(empm_error_t), intent(inout) :: err   !! set on invalid parameters
+    associate (unused_ => self, unused_grid_ => grid, unused_group_ => group, unused_err_ => err)
+    end associate
+  end subroutine shape_configure
+
+  !> Cells of grid a body needs beyond its material on every side so that every particle's
+  !> support fits in the grid (uGIMP and B-splines 1); the default, 0, is for families whose
+  !> support never needs nodes outside the grid (linear, LME).
+  pure integer function shape_padding_cells(self) result(n)
+    class(empm_shape_t), intent(in) :: self !! shape family
+    associate (unused_ => self); end associate
+    n = 0
+  end function shape_padding_cells
+
   !> Basis layout the family fills fastest on `grid`; the default is BASIS_LISTS, the only
   !> layout every family fills. A family overriding it must fill that layout in `eval_batch`.
   pure integer function shape_layout(self, grid)
@@ -139,12 +172,17 @@ contains
 
   !> Allocate basis storage for `np` particles with up to `maxn` nodes each, in `layout`
   !> (default BASIS_LISTS; BASIS_Q4 needs ndim = 2 and maxn >= 4, otherwise lists are used).
-  subroutine basis_alloc(self, ndim, maxn, np, layout)
+  !> An allocation failure is reported in `err` when present (with the memory asked for),
+  !> otherwise it stops the program.
+  subroutine basis_alloc(self, ndim, maxn, np, layout, err)
     class(empm_basis_t), intent(inout) :: self !! basis storage
     integer, intent(in) :: ndim                !! spatial dimension
     integer, intent(in) :: maxn                !! nodes per particle (capacity)
     integer, intent(in) :: np                  !! number of particles
     integer, intent(in), optional :: layout    !! BASIS_LISTS (default) or BASIS_Q4
+    type(empm_error_t), intent(inout), optional :: err !! set on an allocation failure
+    integer :: stat
+    character(len=256) :: msg
     if (allocated(self%nn)) deallocate(self%nn, self%node, self%N, self%dN)
     if (allocated(self%cell)) deallocate(self%cell, self%t)
     self%ndim = ndim; self%maxn = maxn; self%np = np
@@ -153,11 +191,23 @@ contains
       if (layout == BASIS_Q4 .and. ndim == 2 .and. maxn >= 4) self%layout = BASIS_Q4
     end if
     if (self%layout == BASIS_Q4) then
-      allocate(self%cell(np), self%t(2, np))
+      allocate(self%cell(np), self%t(2, np), stat=stat, errmsg=msg)
+      if (stat /= 0) then
+        call empm_raise_error(empm_alloc_error('shape functions ('//str(np)//' particles)', &
+          20_int64 * np, msg), err)
+        return
+      end if
       self%cell = 1; self%t = 0.0_wp
       self%stride = 0; self%inv_h = 1.0_wp
     else
-      allocate(self%nn(np), self%node(maxn, np), self%N(maxn, np), self%dN(ndim, maxn, np))
+      allocate(self%nn(np), self%node(maxn, np), self%N(maxn, np), self%dN(ndim, maxn, np), &
+               stat=stat, errmsg=msg)
+      if (stat /= 0) then
+        call empm_raise_error(empm_alloc_error('shape functions ('//str(np)//' particles x '// &
+          str(maxn)//' nodes)', int(np, int64) * (4_int64 + maxn * (12_int64 + 8_int64 * ndim)), &
+          msg), err)
+        return
+      end if
       self%nn = 0; self%node = 1; self%N = 0.0_wp; self%dN = 0.0_wp
     end if
   end subroutine basis_alloc
@@ -193,8 +243,9 @@ contains
   end subroutine basis_get
 
   !> Bilinear values and gradients from the local coordinates (t1, t2) of a cell with 1/h =
-  !> (h1, h2); nodes in increasing index order (x fastest). The one definition of the Q4
-  !> basis: the linear family's 2D kernel and the Q4 transfers use these expressions.
+  !> (h1, h2); nodes in increasing index order (x fastest). The Q4 basis for the linear
+  !> family's 2D kernel and [[basis_get]]; the expressions are those of empm_q4_weights.inc,
+  !> which the Q4 transfers include too (the same bits in both layouts).
   pure subroutine basis_q4_weights(t1, t2, h1, h2, N, dN)
     real(wp), intent(in) :: t1        !! local coordinate along x, in [0, 1]
     real(wp), intent(in) :: t2        !! local coordinate along y, in [0, 1]
@@ -202,14 +253,11 @@ contains
     real(wp), intent(in) :: h2        !! 1/h along y
     real(wp), intent(out) :: N(4)     !! values
     real(wp), intent(out) :: dN(2, 4) !! gradients
-    real(wp) :: u1, u2
-    u1 = 1.0_wp - t1; u2 = 1.0_wp - t2
-    N(1) = u1 * u2; N(2) = t1 * u2; N(3) = u1 * t2; N(4) = t1 * t2
-    dN(1, 1) = -h1 * u2; dN(2, 1) = -u1 * h2
-    dN(1, 2) = h1 * u2;  dN(2, 2) = -t1 * h2
-    dN(1, 3) = -h1 * t2; dN(2, 3) = u1 * h2
-    dN(1, 4) = h1 * t2;  dN(2, 4) = t1 * h2
+    call q4_values(t1, t2, N)
+    call q4_gradients(t1, t2, h1, h2, -h1, -h2, dN)
   end subroutine basis_q4_weights
+
+  include 'empm_q4_weights.inc'
 
   !> Human-readable text for a SHAPE_* status code.
   pure function shape_status_text(info) result(s)

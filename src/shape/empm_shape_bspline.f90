@@ -37,6 +37,9 @@ module empm_shape_bspline
     procedure :: eval_point => bspline_eval_point
     procedure :: eval_batch => bspline_eval_batch
     procedure :: name => bspline_name
+    procedure :: family => bspline_family
+    procedure :: summary => bspline_summary
+    procedure :: padding_cells => bspline_padding_cells
   end type empm_shape_bspline_t
 
 contains
@@ -51,6 +54,39 @@ contains
       bspline_max_nodes = 0
     end if
   end function bspline_max_nodes
+
+  !> Registry name of the family: "bspline2" or "bspline3" (each order is its own family;
+  !> "bspline?" for an unsupported order).
+  pure function bspline_family(self) result(s)
+    class(empm_shape_bspline_t), intent(in) :: self !! shape family
+    character(len=:), allocatable :: s              !! name
+    select case (self%order)
+    case (2); s = 'bspline2'
+    case (3); s = 'bspline3'
+    case default; s = 'bspline?'
+    end select
+  end function bspline_family
+
+  !> One-line description of the family.
+  pure function bspline_summary(self) result(s)
+    class(empm_shape_bspline_t), intent(in) :: self !! shape family
+    character(len=:), allocatable :: s              !! summary
+    select case (self%order)
+    case (2); s = 'uniform quadratic B-splines: support radius 1.5h, 3 nodes per direction; '// &
+                  'one padding cell'
+    case (3); s = 'uniform cubic B-splines: support radius 2h, 4 nodes per direction; '// &
+                  'one padding cell'
+    case default; s = 'uniform B-splines of an unsupported order'
+    end select
+  end function bspline_summary
+
+  !> Padding cells: 1 (the uniform spline needs nodes beyond the grid within h/2 (quadratic) or
+  !> h (cubic) of a face: SHAPE_SUPPORT_CLIPPED).
+  pure integer function bspline_padding_cells(self) result(n)
+    class(empm_shape_bspline_t), intent(in) :: self !! shape family
+    associate (unused_ => self); end associate
+    n = 1
+  end function bspline_padding_cells
 
   !> Family identifier: "bspline2" or "bspline3" ("bspline?" for an unsupported order).
   function bspline_name(self) result(s)
@@ -92,7 +128,8 @@ contains
     if (info /= SHAPE_OK) return
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
-    !$omp parallel do schedule(static) private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
+    !$omp parallel do default(none) schedule(static) shared(self, grid, pts, basis, ibad, info) &
+    !$omp   private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
       call shape_bspline_kernel(self%order, grid, pts%x(:, p), basis%nn(p), basis%node(:, p), &
                                 basis%N(:, p), basis%dN(:, :, p), pinfo)

@@ -35,6 +35,8 @@ module empm_shape_linear
     procedure :: eval_point => linear_eval_point
     procedure :: eval_batch => linear_eval_batch
     procedure :: name => linear_name
+    procedure :: family => linear_family
+    procedure :: summary => linear_summary
     procedure :: layout => linear_layout
   end type empm_shape_linear_t
 
@@ -57,6 +59,23 @@ contains
     linear_layout = BASIS_LISTS
     if (grid%ndim == 2) linear_layout = BASIS_Q4
   end function linear_layout
+
+  !> Registry name of the family.
+  pure function linear_family(self) result(s)
+    class(empm_shape_linear_t), intent(in) :: self !! shape family
+    character(len=:), allocatable :: s             !! name
+    associate (unused_ => self); end associate
+    s = 'linear'
+  end function linear_family
+
+  !> One-line description of the family.
+  pure function linear_summary(self) result(s)
+    class(empm_shape_linear_t), intent(in) :: self !! shape family
+    character(len=:), allocatable :: s             !! summary
+    associate (unused_ => self); end associate
+    s = 'linear finite elements on the grid cells: bar (1D), Q4 (2D), H8 (3D); no padding '// &
+        'needed'
+  end function linear_summary
 
   !> Family identifier: "linear".
   function linear_name(self) result(s)
@@ -103,8 +122,8 @@ contains
       end if
       nc = empm_chunks(pts%np)
       ibad = huge(1)
-      !$omp parallel do num_threads(nc) schedule(static, 1) private(p0, p1, b) &
-      !$omp   reduction(min: ibad) if(nc > 1)
+      !$omp parallel do default(none) num_threads(nc) schedule(static, 1) &
+      !$omp   shared(nc, q4, grid, pts, basis) private(p0, p1, b) reduction(min: ibad) if(nc > 1)
       do c = 0, nc - 1
         call empm_chunk_bounds(pts%np, nc, c, p0, p1)
         if (q4) then
@@ -125,7 +144,8 @@ contains
     end if
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
-    !$omp parallel do schedule(static) private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
+    !$omp parallel do default(none) schedule(static) shared(grid, pts, basis, ibad, info) &
+    !$omp   private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
       call shape_linear_kernel(grid, pts%x(:, p), basis%nn(p), basis%node(:, p), &
                                basis%N(:, p), basis%dN(:, :, p), pinfo)

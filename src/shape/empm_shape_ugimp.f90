@@ -42,6 +42,9 @@ module empm_shape_ugimp
     procedure :: eval_point => ugimp_eval_point
     procedure :: eval_batch => ugimp_eval_batch
     procedure :: name => ugimp_name
+    procedure :: family => ugimp_family
+    procedure :: summary => ugimp_summary
+    procedure :: padding_cells => ugimp_padding_cells
   end type empm_shape_ugimp_t
 
 contains
@@ -53,6 +56,30 @@ contains
     associate (unused_ => self); end associate
     ugimp_max_nodes = 3**grid%ndim
   end function ugimp_max_nodes
+
+  !> Registry name of the family.
+  pure function ugimp_family(self) result(s)
+    class(empm_shape_ugimp_t), intent(in) :: self !! shape family
+    character(len=:), allocatable :: s            !! name
+    associate (unused_ => self); end associate
+    s = 'ugimp'
+  end function ugimp_family
+
+  !> One-line description of the family.
+  pure function ugimp_summary(self) result(s)
+    class(empm_shape_ugimp_t), intent(in) :: self !! shape family
+    character(len=:), allocatable :: s            !! summary
+    associate (unused_ => self); end associate
+    s = 'uniform GIMP (Bardenhagen & Kober 2004): the linear hat convolved with the particle '// &
+        'box, C¹, up to 3 nodes per direction; one padding cell'
+  end function ugimp_summary
+
+  !> Padding cells: 1 (a particle domain reaching past the grid box is SHAPE_SUPPORT_CLIPPED).
+  pure integer function ugimp_padding_cells(self) result(n)
+    class(empm_shape_ugimp_t), intent(in) :: self !! shape family
+    associate (unused_ => self); end associate
+    n = 1
+  end function ugimp_padding_cells
 
   !> Family identifier: "ugimp".
   function ugimp_name(self) result(s)
@@ -92,7 +119,8 @@ contains
     if (info /= SHAPE_OK) return
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
-    !$omp parallel do schedule(static) private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
+    !$omp parallel do default(none) schedule(static) shared(grid, pts, basis, ibad, info) &
+    !$omp   private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
       call shape_ugimp_kernel(grid, pts%x(:, p), pts%lp(:, p), basis%nn(p), basis%node(:, p), &
                               basis%N(:, p), basis%dN(:, :, p), pinfo)

@@ -1,0 +1,342 @@
+!> LME evaluation entry points: one point (`eval_point`), every particle (`eval_batch`: the
+!> particle-parallel loop with the extrapolated warm start and the lean 2D path) and the
+!> 'enlarge' remedy around the general path.
+!>
+!> The lean 2D path (`lme_point_2d`, with its fused weight-and-moment pass `weights_2d` and 2×2
+!> inverse `inverse_2d`) is made of internal procedures of the batch routine: local to this
+!> file, so the compiler inlines `lme_point_2d` into the particle loop and calls the others
+!> directly, as it did when LME was one module. (Submodule procedures have external linkage;
+!> in the position-independent library that blocks inlining and specialisation.)
+submodule (empm_shape_lme) empm_shape_lme_batch
+  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
+  use empm_shape, only: SHAPE_OK, SHAPE_SUPPORT_CLIPPED, SHAPE_NOT_CONVERGED, SHAPE_OUTSIDE_HULL, &
+                        SHAPE_SINGULAR
+  use empm_shape_linear, only: shape_batch_fits, shape_keep_first_failure
+  implicit none
+
+contains
+
+  module procedure lme_eval_point
+    integer :: iters
+    associate (unused_lp_ => lp); end associate
+    call lme_point(self, grid, x, lam, 1.0_wp, nn, node, N, dN, iters, info)
+    if (info /= SHAPE_OK .and. self%remedy == LME_REMEDY_ENLARGE) &
+      call lme_remedy(self, grid, x, lam, nn, node, N, dN, iters, info)
+  end procedure lme_eval_point
+
+  module procedure lme_eval_point_iters
+    call lme_point(self, grid, x, lam, 1.0_wp, nn, node, N, dN, iters, info)
+    if (info /= SHAPE_OK .and. self%remedy == LME_REMEDY_ENLARGE) &
+      call lme_remedy(self, grid, x, lam, nn, node, N, dN, iters, info)
+  end procedure lme_eval_point_iters
+
+  module procedure lme_eval_batch
+    integer :: iters
+    call lme_batch(self, grid, pts, basis, ibad, info, iters)
+  end procedure lme_eval_batch
+
+  module procedure lme_eval_batch_iters
+    call lme_batch(self, grid, pts, basis, ibad, info, iters)
+  end procedure lme_eval_batch_iters
+
+  !> Batch loop without polymorphic calls: per particle `lme_point_2d` (2D, uniform γ) or
+  !> [[lme_point]], then [[lme_remedy]] after a failure when enabled.
+  subroutine lme_batch(self, grid, pts, basis, ibad, info, iters)
+    type(empm_shape_lme_t), intent(in) :: self   !! shape family
+    type(empm_grid_t), intent(in) :: grid        !! background grid
+    type(empm_particles_t), intent(inout) :: pts !! particles (λ updated)
+    type(empm_basis_t), intent(inout) :: basis   !! filled for particles 1..pts%np
+    integer, intent(out) :: ibad                 !! first failing particle, 0 if none
+    integer, intent(out) :: info                 !! SHAPE_OK or the failing particle's code
+    integer, intent(out) :: iters                !! total Newton iterations
+    integer :: p, it, pinfo, nd
+    real(wp) :: lam(3), hs, cut, rmax
+    logical :: fast
+    iters = 0
+    call shape_batch_fits(pts%np, basis, ibad, info)
+    if (info /= SHAPE_OK) return
+    nd = grid%ndim
+    ! The lean 2D path needs uniform γ and valid parameters (a support larger than the storage
+    ! falls back, and the general path reports it).
+    fast = nd == 2 .and. .not. allocated(self%gamma_node) .and. params_ok(self, grid)
+    hs = lme_h(grid)
+    cut = -log(self%tol0)
+    rmax = sqrt(cut / self%gamma) * hs
+    ! Particles are independent: threads share them; the first failure (lowest index) is kept.
+    ibad = huge(1)
+    !$omp parallel do default(none) schedule(static) &
+    !$omp   shared(self, grid, pts, basis, fast, nd, hs, cut, rmax, ibad, info) &
+    !$omp   private(pinfo, it, lam) reduction(+: iters) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
+    do p = 1, pts%np
+      ! Warm start extrapolated from the last two converged multipliers: in a smooth motion
+      ! λ* changes smoothly, so 2λ_n − λ_(n−1) is off by O(Δx²) and one Newton step usually
+      ! reaches the tolerance (the plain warm start λ_n needs two). lam_old = huge marks a
+      ! particle without a converged history yet (set at generation): plain warm start.
+      if (pts%lam_old(1, p) == huge(1.0_wp)) then
+        lam(1:nd) = pts%lam(:, p)
+      else
+        lam(1:nd) = 2.0_wp * pts%lam(:, p) - pts%lam_old(:, p)
+      end if
+      it = LME_FALLBACK
+      if (fast) call lme_point_2d(grid, pts%x(:, p), self%gamma, cut, hs, rmax, &
+        self%max_iter, lam, basis%maxn, basis%nn(p), basis%node(:, p), basis%N(:, p), &
+        basis%dN(:, :, p), it)
+      if (it == LME_FALLBACK) then
+        ! Anything unusual: the guarded general path, from the same warm start. (The remedy is
+        ! a separate call after a failure: the common call passes its arrays once.)
+        call lme_point(self, grid, pts%x(:, p), lam(1:nd), 1.0_wp, basis%nn(p), &
+                       basis%node(:, p), basis%N(:, p), basis%dN(:, :, p), it, pinfo)
+        if (pinfo /= SHAPE_OK .and. self%remedy == LME_REMEDY_ENLARGE) &
+          call lme_remedy(self, grid, pts%x(:, p), lam(1:nd), basis%nn(p), basis%node(:, p), &
+                          basis%N(:, p), basis%dN(:, :, p), it, pinfo)
+      else
+        pinfo = SHAPE_OK
+      end if
+      if (pinfo == SHAPE_OK) then
+        if (pts%lam_old(1, p) == huge(1.0_wp)) then
+          pts%lam_old(:, p) = lam(1:nd)
+        else
+          pts%lam_old(:, p) = pts%lam(:, p)
+        end if
+        pts%lam(:, p) = lam(1:nd)
+      end if
+      iters = iters + it
+      if (pinfo /= SHAPE_OK) call shape_keep_first_failure(p, pinfo, ibad, info)
+    end do
+    !$omp end parallel do
+    if (ibad == huge(1)) ibad = 0
+
+  contains
+
+    !> The common case, lean: 2D, uniform γ, a warm start near λ*. The same basis as
+    !> [[lme_point]] (to the Newton tolerance), with the work fused into three passes over the
+    !> support: one finds the candidates (all active, since the box is filtered by
+    !> γ|ξ|² ≤ −ln tol0) and their exponents, one evaluates the weights and their moments up to
+    !> third order (about the heaviest node), one writes values and gradients. Newton stops as
+    !> soon as a bound proves the residual after the final linearised step below the tolerance;
+    !> the moments of the final values follow from the third moments without another pass over
+    !> the nodes (docs/shape-functions.md, "The 2D batch path"). Only full Newton steps are
+    !> taken here: whenever the general path could do something else (point outside the grid,
+    !> ‖r‖ above the Armijo threshold, ill-conditioned J, a step or λ beyond its cap, the
+    !> iteration cap, too few candidates or x outside their bounding box), `iters` returns
+    !> `LME_FALLBACK` and the caller starts [[lme_point]] over.
+    pure subroutine lme_point_2d(grid, x, gamma, cut, h, rmax, maxit, lam, cap, nn, node, N, &
+                                 dN, iters)
+      type(empm_grid_t), intent(in) :: grid     !! background grid (2D)
+      real(wp), intent(in) :: x(2)              !! point
+      real(wp), intent(in) :: gamma             !! γ
+      real(wp), intent(in) :: cut               !! −ln tol0
+      real(wp), intent(in) :: h                 !! nodal spacing of γ [length]
+      real(wp), intent(in) :: rmax              !! support radius [length]
+      integer, intent(in) :: maxit              !! Newton iteration cap
+      real(wp), intent(inout) :: lam(2)         !! λ [1/length]: warm start in, λ* out
+      integer, intent(in) :: cap                !! storage per point
+      integer, intent(out) :: nn                !! number of supporting nodes
+      integer, intent(out) :: node(cap)         !! node indices
+      real(wp), intent(out) :: N(cap)           !! values
+      real(wp), intent(out) :: dN(2, cap)       !! gradients
+      integer, intent(out) :: iters             !! Newton iterations, or LME_FALLBACK
+      real(wp) :: s1, s2, rd1, rd2, xi1, xi2, q, f, fmax, qmax, x2max, xlo1, xhi1, xlo2, xhi2
+      real(wp) :: l1, l2, c1, c2, sw, m1(2), m2(3), m3(4), logz, r(2), jm(3), ji(3), scl, rn
+      real(wp) :: d1, d2, dn2, b1, b2, mm(4), det, q1, q2, t1(2), t2(3), st, rt1, rt2, p, v1, v2
+      integer :: lo1, hi1, lo2, hi2, i, j, id0, a, amax, it
+      nn = 0
+      it = 0
+      ! LME_FALLBACK until the very end: every early return hands over to the general path.
+      iters = LME_FALLBACK
+      if (.not. grid%inside(x)) return
+      l1 = lam(1) * h; l2 = lam(2) * h
+      if (.not. (abs(l1) <= LME_LAM_MAX .and. abs(l2) <= LME_LAM_MAX)) return
+      ! Candidates: the index box of the lattice nodes within R of x, filtered by distance, with
+      ! ξ and γ|ξ|² the expressions of lme_point; their exponents f = −γ|ξ|² + λ·ξ at once.
+      s1 = (x(1) - grid%origin(1)) * grid%inv_h(1); rd1 = rmax * grid%inv_h(1)
+      s2 = (x(2) - grid%origin(2)) * grid%inv_h(2); rd2 = rmax * grid%inv_h(2)
+      lo1 = max(0, ceiling(s1 - rd1)); hi1 = min(grid%ncell(1), floor(s1 + rd1))
+      lo2 = max(0, ceiling(s2 - rd2)); hi2 = min(grid%ncell(2), floor(s2 + rd2))
+      fmax = -huge(1.0_wp); amax = 0; qmax = 0.0_wp
+      xlo1 = huge(1.0_wp); xhi1 = -huge(1.0_wp); xlo2 = huge(1.0_wp); xhi2 = -huge(1.0_wp)
+      do j = lo2, hi2
+        xi2 = (x(2) - (grid%origin(2) + j * grid%h(2))) / h
+        id0 = 1 + grid%nn(1) * j
+        do i = lo1, hi1
+          xi1 = (x(1) - (grid%origin(1) + i * grid%h(1))) / h
+          q = gamma * (xi1**2 + xi2**2)
+          if (q > cut) cycle
+          if (nn == cap) return
+          nn = nn + 1
+          node(nn) = id0 + i
+          dN(1, nn) = xi1; dN(2, nn) = xi2
+          f = -q + (l1 * xi1 + l2 * xi2)
+          N(nn) = f
+          if (f > fmax) then
+            fmax = f; amax = nn
+          end if
+          qmax = max(qmax, q)
+          xlo1 = min(xlo1, xi1); xhi1 = max(xhi1, xi1)
+          xlo2 = min(xlo2, xi2); xhi2 = max(xhi2, xi2)
+        end do
+      end do
+      ! Direct hull tests of the general path: d + 1 nodes, x in their bounding box (flat sets
+      ! show up below as a singular J).
+      if (nn < 3) return
+      if (.not. (xhi1 >= 0.0_wp .and. xlo1 <= 0.0_wp .and. xhi2 >= 0.0_wp .and. &
+                 xlo2 <= 0.0_wp)) return
+      x2max = qmax / gamma
+      c1 = dN(1, amax); c2 = dN(2, amax)
+      call weights_2d(nn, fmax, c1, c2, dN, N, sw, m1, m2, m3, logz, r, jm)
+      do
+        ! Newton step Δ = −J⁻¹r, full steps only (‖r‖ small).
+        rn = sqrt(r(1)**2 + r(2)**2)
+        if (logz < -qmax - 1.0e-9_wp * (1.0_wp + qmax)) return
+        if (rn > LME_TOL_GUARD) return
+        call inverse_2d(jm, ji, scl)
+        if (scl < LME_J_MIN) return
+        d1 = -(ji(1) * r(1) + ji(2) * r(2)) / scl
+        d2 = -(ji(2) * r(1) + ji(3) * r(2)) / scl
+        dn2 = d1**2 + d2**2
+        ! Done when r(λ+Δ), bounded by ½ (ξmax + ‖r‖)³ |Δ|², is within the tolerance.
+        if (rn < LME_TOL_CONV .or. &
+            0.5_wp * (sqrt(x2max) + rn)**3 * dn2 < LME_TOL_CONV) exit
+        if (it >= maxit .or. dn2 > LME_STEP_MAX**2) return
+        l1 = l1 + d1; l2 = l2 + d2
+        it = it + 1
+        if (.not. (abs(l1) <= LME_LAM_MAX .and. abs(l2) <= LME_LAM_MAX)) return
+        fmax = -huge(1.0_wp); amax = 0
+        do a = 1, nn
+          f = -(gamma * (dN(1, a)**2 + dN(2, a)**2)) + (l1 * dN(1, a) + l2 * dN(2, a))
+          N(a) = f
+          if (f > fmax) then
+            fmax = f; amax = a
+          end if
+        end do
+        c1 = dN(1, amax); c2 = dN(2, amax)
+        call weights_2d(nn, fmax, c1, c2, dN, N, sw, m1, m2, m3, logz, r, jm)
+      end do
+      ! Final values p̂_a ∝ w_a (1 + q·u_a), u = ξ − c, the linearised step with q chosen so that
+      ! Σ p̂ ξ = 0 holds exactly (not only to first order): Σ w (1 + q·u) ξ = 0, i.e.
+      ! (S1 + S0 c) + M q = 0 with M = S2 + c⊗S1. q = Δ + O(|Δ|²), so p̂ = p* + O(|Δ|²), within
+      ! the bound above; reproduction holds to round-off whatever the early stop left in r.
+      ! The moments of p̂ follow from S0..S3: ŝ = S0 + q·S1, Σ w Q u = S1 + S2 q,
+      ! Σ w Q u⊗u = S2 + S3[q], so no pass over the nodes is needed before the last one.
+      b1 = m1(1) + sw * c1; b2 = m1(2) + sw * c2
+      mm(1) = m2(1) + c1 * m1(1); mm(2) = m2(2) + c1 * m1(2)
+      mm(3) = m2(2) + c2 * m1(1); mm(4) = m2(3) + c2 * m1(2)
+      det = mm(1) * mm(4) - mm(2) * mm(3)
+      if (.not. (abs(det) > LME_J_MIN * sw * sw)) return
+      q1 = -(mm(4) * b1 - mm(2) * b2) / det
+      q2 = -(mm(1) * b2 - mm(3) * b1) / det
+      ! The general path's guard on the linearisation: every factor 1 + q·u above 1/2.
+      if (sqrt(q1**2 + q2**2) * (sqrt(x2max) + sqrt(c1**2 + c2**2)) > 0.5_wp) return
+      st = sw + (m1(1) * q1 + m1(2) * q2)
+      t1(1) = m1(1) + (m2(1) * q1 + m2(2) * q2)
+      t1(2) = m1(2) + (m2(2) * q1 + m2(3) * q2)
+      t2(1) = m2(1) + (m3(1) * q1 + m3(2) * q2)
+      t2(2) = m2(2) + (m3(2) * q1 + m3(3) * q2)
+      t2(3) = m2(3) + (m3(3) * q1 + m3(4) * q2)
+      rt1 = t1(1) / st; rt2 = t1(2) / st
+      jm(1) = t2(1) / st - rt1 * rt1
+      jm(2) = t2(2) / st - rt1 * rt2
+      jm(3) = t2(3) / st - rt2 * rt2
+      call inverse_2d(jm, ji, scl)
+      if (scl < LME_J_MIN) return
+      ji = ji / scl
+      ! r̂ − c = (rt1, rt2); ∇p̂_a = −p̂_a Ĵ⁻¹ (ξ_a − r̂)/h.
+      do a = 1, nn
+        v1 = dN(1, a) - c1; v2 = dN(2, a) - c2
+        p = N(a) * (1.0_wp + (q1 * v1 + q2 * v2)) / st
+        N(a) = p
+        v1 = v1 - rt1; v2 = v2 - rt2
+        dN(1, a) = -p * (ji(1) * v1 + ji(2) * v2) / h
+        dN(2, a) = -p * (ji(2) * v1 + ji(3) * v2) / h
+      end do
+      lam(1) = (l1 + d1) / h; lam(2) = (l2 + d2) / h
+      iters = it
+
+    end subroutine lme_point_2d
+
+    !> 2D weights w_a = exp(f_a − fm) (f in `w` on entry), their moments about c up to third
+    !> order (S0 = Σw, S1 = Σ w u, S2 = Σ w u⊗u as (11, 12, 22), S3 as (111, 112, 122, 222),
+    !> u = ξ − c), and log Z, r and J (11, 12, 22) of the normalised weights.
+    pure subroutine weights_2d(nn, fm, c1, c2, xi, w, sw, m1, m2, m3, logz, r, jm)
+      integer, intent(in) :: nn            !! number of nodes
+      real(wp), intent(in) :: fm           !! max f
+      real(wp), intent(in) :: c1           !! centre of the moments, x
+      real(wp), intent(in) :: c2           !! centre of the moments, y
+      real(wp), intent(in) :: xi(2, *)     !! ξ_a
+      real(wp), intent(inout) :: w(*)      !! in: f_a; out: w_a
+      real(wp), intent(out) :: sw          !! S0
+      real(wp), intent(out) :: m1(2)       !! S1
+      real(wp), intent(out) :: m2(3)       !! S2
+      real(wp), intent(out) :: m3(4)       !! S3
+      real(wp), intent(out) :: logz        !! log Z
+      real(wp), intent(out) :: r(2)        !! r = Σ p ξ
+      real(wp), intent(out) :: jm(3)       !! J
+      real(wp) :: e, u1, u2, eu1, eu2
+      integer :: b
+      sw = 0.0_wp; m1 = 0.0_wp; m2 = 0.0_wp; m3 = 0.0_wp
+      do b = 1, nn
+        e = exp(w(b) - fm)
+        w(b) = e
+        u1 = xi(1, b) - c1; u2 = xi(2, b) - c2
+        eu1 = e * u1; eu2 = e * u2
+        sw = sw + e
+        m1(1) = m1(1) + eu1; m1(2) = m1(2) + eu2
+        m2(1) = m2(1) + eu1 * u1; m2(2) = m2(2) + eu1 * u2; m2(3) = m2(3) + eu2 * u2
+        m3(1) = m3(1) + (eu1 * u1) * u1; m3(2) = m3(2) + (eu1 * u1) * u2
+        m3(3) = m3(3) + (eu1 * u2) * u2; m3(4) = m3(4) + (eu2 * u2) * u2
+      end do
+      logz = fm + log(sw)
+      r(1) = c1 + m1(1) / sw; r(2) = c2 + m1(2) / sw
+      jm(1) = m2(1) / sw - (m1(1) / sw)**2
+      jm(2) = m2(2) / sw - (m1(1) / sw) * (m1(2) / sw)
+      jm(3) = m2(3) / sw - (m1(2) / sw)**2
+    end subroutine weights_2d
+
+    !> (J/‖J‖_F)⁻¹ of a symmetric 2×2 J = (j11, j12, j22) by its adjugate, and ‖J‖_F; `nrm` = 0
+    !> when J is not positive definite to within the Frobenius condition LME_COND_MAX.
+    pure subroutine inverse_2d(jj, jinv, nrm)
+      real(wp), intent(in) :: jj(3)        !! J
+      real(wp), intent(out) :: jinv(3)     !! (J/‖J‖)⁻¹
+      real(wp), intent(out) :: nrm         !! ‖J‖_F, or 0 on failure
+      real(wp) :: b11, b12, b22, det, nadj
+      nrm = sqrt(jj(1)**2 + 2.0_wp * jj(2)**2 + jj(3)**2)
+      jinv = 0.0_wp
+      if (.not. (nrm > sqrt(SUMSQ_LO) .and. nrm < sqrt(SUMSQ_HI))) then
+        nrm = 0.0_wp; return
+      end if
+      b11 = jj(1) / nrm; b12 = jj(2) / nrm; b22 = jj(3) / nrm
+      det = b11 * b22 - b12 * b12
+      nadj = sqrt(b11**2 + 2.0_wp * b12**2 + b22**2)
+      if (.not. (det > 0.0_wp .and. det * LME_COND_MAX > nadj)) then
+        nrm = 0.0_wp; return
+      end if
+      jinv(1) = b22 / det; jinv(2) = -b12 / det; jinv(3) = b11 / det
+    end subroutine inverse_2d
+  end subroutine lme_batch
+
+  !> The 'enlarge' remedy, after the first attempt at x failed with `info`: while the failure
+  !> is one a larger support can cure, evaluate again from λ = 0 with every γ halved, then
+  !> quartered; the first success (or the last failure) is returned.
+  pure subroutine lme_remedy(self, grid, x, lam, nn, node, N, dN, iters, info)
+    type(empm_shape_lme_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid      !! background grid
+    real(wp), intent(in) :: x(:)               !! point (ndim)
+    real(wp), intent(inout) :: lam(:)          !! λ: converged λ out on success
+    integer, intent(inout) :: nn               !! number of supporting nodes (0 on failure)
+    integer, intent(inout) :: node(:)          !! supporting node indices
+    real(wp), intent(inout) :: N(:)            !! values
+    real(wp), intent(inout) :: dN(:,:)         !! gradients (ndim, :)
+    integer, intent(inout) :: iters            !! Newton iterations of the last attempt
+    integer, intent(inout) :: info             !! in: the first attempt's failure; out: result
+    integer :: k
+    do k = 1, LME_REMEDY_TRIES
+      select case (info)
+      case (SHAPE_OUTSIDE_HULL, SHAPE_SUPPORT_CLIPPED, SHAPE_SINGULAR, SHAPE_NOT_CONVERGED)
+        lam(1:grid%ndim) = 0.0_wp
+        call lme_point(self, grid, x, lam, LME_REMEDY_FACTOR**k, nn, node, N, dN, iters, info)
+      case default
+        return
+      end select
+    end do
+  end subroutine lme_remedy
+end submodule empm_shape_lme_batch
