@@ -4,8 +4,8 @@ program empm_main
   use empm, only: empm_version, empm_run_case, empm_error_t
   use empm_terminal, only: empm_exit
   use empm_files, only: empm_mkdir_p
-  use empm_kinds, only: wp
   use empm_verify_suite, only: empm_verify_run
+  use empm_input, only: empm_input_markdown
   use empm_bench, only: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json
   implicit none
   integer :: nargs, i, ios, nfail, npat
@@ -42,7 +42,8 @@ program empm_main
       end select
     end do
     if (len(case_file) == 0) call die('empm run needs a case file: empm run CASE.nml')
-    call empm_run_case(case_file, out_file, written=written, err=err)
+    ! A verification case file also runs: its &verify group is the suite's, not the run's.
+    call empm_run_case(case_file, out_file, written=written, err=err, extra_groups='verify')
     if (err%code /= 0) then
       write(error_unit, '(a)') 'empm: error: '//err%message
       call empm_exit(err%code)
@@ -84,7 +85,6 @@ program empm_main
       select case (arg(i))
       case ('--dim');        bcfg%dim = int_arg(i)
       case ('--shape');      bcfg%shape = arg(i + 1)
-      case ('--gamma');      bcfg%gamma = real_arg(i)
       case ('--cells');      bcfg%cells = int_arg(i)
       case ('--ppc');        bcfg%ppc = int_arg(i)
       case ('--steps');      bcfg%steps = int_arg(i)
@@ -101,6 +101,9 @@ program empm_main
       call empm_exit(err%code)
     end if
     write(output_unit, '(a)') empm_bench_json(bres)
+  case ('keys')
+    if (nargs > 1) call die('empm keys takes no argument')
+    write(output_unit, '(a)', advance='no') empm_input_markdown()
   case default
     call die('unknown command '''//cmd//'''')
   end select
@@ -116,7 +119,7 @@ contains
     call get_command_argument(k, s)
   end function arg
 
-  ! Value of option k (argument k + 1) as an integer / a real; a usage error otherwise.
+  ! Value of option k (argument k + 1) as an integer; a usage error otherwise.
   integer function int_arg(k) result(v)
     integer, intent(in) :: k
     integer :: ios
@@ -125,15 +128,6 @@ contains
     read(text, *, iostat=ios) v
     if (ios /= 0) call die('option '//arg(k)//' needs an integer, got '''//arg(k + 1)//'''')
   end function int_arg
-
-  real(wp) function real_arg(k) result(v)
-    integer, intent(in) :: k
-    integer :: ios
-    character(len=:), allocatable :: text
-    text = arg(k + 1)
-    read(text, *, iostat=ios) v
-    if (ios /= 0) call die('option '//arg(k)//' needs a number, got '''//arg(k + 1)//'''')
-  end function real_arg
 
   subroutine die(msg)
     character(len=*), intent(in) :: msg
@@ -145,7 +139,8 @@ contains
     integer, intent(in) :: u
     write(u, '(a)') 'usage: empm run CASE.nml [-o OUT.h5]'
     write(u, '(a)') '       empm verify [PATTERN...] [--quick] [--out DIR] [--manifest FILE]'
-    write(u, '(a)') '       empm bench [--dim 2|3] [--shape S] [--gamma G] [--cells N] [--ppc P] [--steps K]'
+    write(u, '(a)') '       empm keys'
+    write(u, '(a)') '       empm bench [--dim 2|3] [--shape S] [--cells N] [--ppc P] [--steps K]'
     write(u, '(a)') '                  [--threads T] [--integrator I] [--warmup W]'
     write(u, '(a)') '       empm --help | --version'
     write(u, '(a)') ''
@@ -159,7 +154,11 @@ contains
     write(u, '(a)') 'and exits with status 5 when a check fails. --quick: coarse levels only.'
     write(u, '(a)') ''
     write(u, '(a)') 'empm bench times a freely vibrating elastic block (N^dim cells, P particles per'
-    write(u, '(a)') 'cell) and prints one JSON object (docs/performance.md).'
+    write(u, '(a)') 'cell) and prints one JSON object (docs/performance.md). S is a shape identifier'
+    write(u, '(a)') 'as in a case file: linear, ugimp, bspline2, bspline3, lme, lme_g<gamma>.'
+    write(u, '(a)') ''
+    write(u, '(a)') 'empm keys prints every key of the case files, with the parameters each shape'
+    write(u, '(a)') 'family, material model and integrator declares (the tables of docs/input.md).'
     write(u, '(a)') ''
     write(u, '(a)') 'exit status: 0 success, 1 usage error, 2 invalid case file,'
     write(u, '(a)') '             3 run stopped by a guard (results marked incomplete), 4 I/O error,'

@@ -26,10 +26,10 @@ module empm_stability
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_particles, only: empm_particles_t
   use empm_particle_gen, only: empm_fill, GEOM_BOX, PLACE_GAUSS
-  use empm_shape_factory, only: empm_shape_create
-  use empm_material_factory, only: empm_material_create
+  use empm_error, only: empm_error_t
+  use empm_namelist, only: empm_kv
+  use empm_registry, only: empm_create_shape, empm_create_material, empm_create_integrator
   use empm_integrator, only: empm_integrator_t
-  use empm_integrator_factory, only: empm_integrator_create
   use empm_linalg, only: empm_eigenvalues
   use empm_solver, only: empm_energies
   implicit none
@@ -48,11 +48,11 @@ module empm_stability
   real(wp), parameter :: H = 1.0_wp      ! cell size
   real(wp), parameter :: AMP = 1.0e-6_wp ! probe amplitude (strains of order 1e-6)
 
-  !> A scheme and its parameters, as accepted by [[empm_integrator_create]].
+  !> A scheme and its parameters, as in a case file's `&integrator` group (created through the
+  !> registry, so that any registered scheme can be analysed).
   type :: empm_scheme_spec_t
-    character(len=16) :: name = 'pc_newmark'  !! integrator name
-    real(wp) :: newmark_gamma = 0.5_wp        !! γ_N of the pc_* schemes
-    real(wp) :: rho_b = 0.8_wp                !! ρ_b of gen_alpha
+    character(len=32) :: name = 'pc_newmark'  !! scheme name
+    character(len=256) :: params = ''         !! its keys as text, e.g. 'rho_b = 0.5'
   end type empm_scheme_spec_t
 
   !> Spectral radius and principal-root measures of one amplification matrix.
@@ -318,15 +318,16 @@ contains
     integer, intent(out) :: info
     real(wp) :: zero3(3)
     integer :: stat, nadd, nsel
+    type(empm_error_t) :: e
     zero3 = 0.0_wp
     info = 1
     if (.not. (position > 0.0_wp .and. position <= 1.0_wp)) return
     call pr%model%grid%init(1, [0.0_wp], [H], [ncell], stat)
     if (stat /= 0) return
     allocate(pr%model%mats(1))
-    call empm_material_create('linear_elastic', E_MOD, 0.0_wp, RHO0, pr%model%mats(1)%model, &
-                              stat)
-    if (stat /= 0) return
+    call empm_create_material('linear_elastic', empm_kv('E', E_MOD)//empm_kv('nu', 0.0_wp)// &
+                              empm_kv('density', RHO0), pr%model%mats(1)%model, e)
+    if (e%code /= 0) return
     if (ncell == 1 .and. ppc == 1) then
       call pr%model%pts%alloc(1, 1)
       call pr%model%pts%append([position * H], H, RHO0, [0.5_wp * H], 1)
@@ -338,12 +339,11 @@ contains
     end if
     call pr%model%nodes%fix_box(pr%model%grid, zero3, zero3, [.true., .false., .false.], &
                                 zero3, nsel)
-    call empm_shape_create('linear', 1, pr%model%shape, stat)
-    if (stat /= 0) return
+    call empm_create_shape('linear', pr%model%grid, pr%model%shape, e)
+    if (e%code /= 0) return
     call pr%model%finalize_setup()
-    call empm_integrator_create(trim(spec%name), pr%integ, stat, &
-                                newmark_gamma=spec%newmark_gamma, rho_b=spec%rho_b)
-    if (stat /= 0) return
+    call empm_create_integrator(trim(spec%name), pr%integ, e, trim(spec%params))
+    if (e%code /= 0) return
     call pr%integ%prepare(pr%model)
     call pr%ref%alloc(1, pr%model%pts%np)
     call pr%ref%copy_state_from(pr%model%pts)

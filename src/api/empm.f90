@@ -3,7 +3,9 @@
 !> Embedding codes can either drive a case file ([[empm_run_case]]) or assemble a model
 !> themselves: grid, particles, shape family, materials, loads and constraints, then
 !> [[empm_solve]] with an integrator. Extension points: [[empm_shape_t]],
-!> [[empm_material_t]], [[empm_integrator_t]].
+!> [[empm_material_t]], [[empm_integrator_t]] (families registered in an [[empm_registry_t]]).
+!> Every name exported here carries the `empm_`/`EMPM_` prefix (renamed on export where the
+!> defining module uses a short name), so that a host code's own names never clash.
 module empm
   use empm_kinds, only: empm_wp => wp, empm_pi => pi
   use empm_version_info, only: empm_version
@@ -15,17 +17,25 @@ module empm
   use empm_particles, only: empm_particles_t
   use empm_particle_gen, only: empm_fill, EMPM_GEOM_BOX => GEOM_BOX, EMPM_GEOM_DISK => GEOM_DISK, &
                                EMPM_PLACE_GAUSS => PLACE_GAUSS, EMPM_PLACE_VOXEL => PLACE_VOXEL
-  use empm_shape, only: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK, BASIS_LISTS, &
-                        BASIS_Q4
-  use empm_shape_factory, only: empm_shape_create, empm_shape_names
-  use empm_shape_lme, only: empm_shape_lme_t, LME_REMEDY_NONE, LME_REMEDY_ENLARGE
+  use empm_shape, only: empm_shape_t, empm_basis_t, empm_shape_status_text => shape_status_text, &
+                        EMPM_SHAPE_OK => SHAPE_OK, EMPM_BASIS_LISTS => BASIS_LISTS, &
+                        EMPM_BASIS_Q4 => BASIS_Q4
+  use empm_shape_lme, only: empm_shape_lme_t, EMPM_LME_REMEDY_NONE => LME_REMEDY_NONE, &
+                            EMPM_LME_REMEDY_ENLARGE => LME_REMEDY_ENLARGE
   use empm_lme_legacy, only: empm_lme_basis
   use empm_material, only: empm_material_t
-  use empm_material_factory, only: empm_material_create, material_status_text
-  use empm_loads, only: empm_loads_t, empm_body_force_t, RAMP_NONE, RAMP_SINE
-  use empm_model, only: empm_model_t, empm_material_slot_t, empm_step_status_t, STEP_OK
+  use empm_loads, only: empm_loads_t, empm_body_force_t, EMPM_RAMP_NONE => RAMP_NONE, &
+                        EMPM_RAMP_SINE => RAMP_SINE
+  use empm_model, only: empm_model_t, empm_material_slot_t, empm_step_status_t, &
+                        EMPM_STEP_OK => STEP_OK
   use empm_integrator, only: empm_integrator_t
-  use empm_integrator_factory, only: empm_integrator_create, empm_integrator_names
+  use empm_registry, only: empm_registry_t, empm_default_registry, empm_create_shape, &
+                           empm_create_material, empm_create_integrator
+  use empm_params, only: empm_param_t, empm_param, EMPM_PARAM_REAL => PARAM_REAL, &
+                         EMPM_PARAM_INT => PARAM_INT, EMPM_PARAM_STR => PARAM_STR, &
+                         EMPM_PARAM_LOGICAL => PARAM_LOGICAL
+  use empm_namelist, only: empm_group_t, empm_group_from_text, empm_kv
+  use empm_family, only: empm_family_t
   use empm_history, only: empm_history_t, empm_snapshot_t
   use empm_solver, only: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
   use empm_output, only: empm_write_results, empm_output_meta_t
@@ -39,15 +49,20 @@ module empm
   ! Discretisation
   public :: empm_grid_t, empm_nodes_t, empm_particles_t
   public :: empm_fill, EMPM_GEOM_BOX, EMPM_GEOM_DISK, EMPM_PLACE_GAUSS, EMPM_PLACE_VOXEL
-  public :: empm_shape_t, empm_basis_t, shape_status_text, SHAPE_OK, BASIS_LISTS, BASIS_Q4
-  public :: empm_shape_create, empm_shape_names
-  public :: empm_shape_lme_t, LME_REMEDY_NONE, LME_REMEDY_ENLARGE, empm_lme_basis
+  public :: empm_shape_t, empm_basis_t, empm_shape_status_text, EMPM_SHAPE_OK, EMPM_BASIS_LISTS
+  public :: EMPM_BASIS_Q4
+  public :: empm_shape_lme_t, EMPM_LME_REMEDY_NONE, EMPM_LME_REMEDY_ENLARGE, empm_lme_basis
   ! Materials and loads
-  public :: empm_material_t, empm_material_create, material_status_text
-  public :: empm_loads_t, empm_body_force_t, RAMP_NONE, RAMP_SINE
+  public :: empm_material_t
+  public :: empm_loads_t, empm_body_force_t, EMPM_RAMP_NONE, EMPM_RAMP_SINE
   ! Model, integrators, solver, output
-  public :: empm_model_t, empm_material_slot_t, empm_step_status_t, STEP_OK
-  public :: empm_integrator_t, empm_integrator_create, empm_integrator_names
+  public :: empm_model_t, empm_material_slot_t, empm_step_status_t, EMPM_STEP_OK
+  public :: empm_integrator_t
+  ! Families: registry, parameter declarations, case-file groups
+  public :: empm_family_t, empm_registry_t, empm_default_registry, empm_create_shape
+  public :: empm_create_material, empm_create_integrator
+  public :: empm_param_t, empm_param, EMPM_PARAM_REAL, EMPM_PARAM_INT, EMPM_PARAM_STR
+  public :: EMPM_PARAM_LOGICAL, empm_group_t, empm_group_from_text, empm_kv
   public :: empm_history_t, empm_snapshot_t
   public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
   public :: empm_write_results, empm_output_meta_t, empm_run_case

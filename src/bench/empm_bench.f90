@@ -3,9 +3,11 @@
 !> with phase timers, Newton iterations and resident memory per particle.
 !>
 !> The block fills `cells`^dim cells of size 1/cells (unit box), with `ppc` particles per cell
-!> at Gauss positions (`ppc` a perfect square in 2D, cube in 3D). Families whose support needs
-!> nodes past the material (uGIMP, B-splines) get one padding cell per side, so the particle
-!> count never depends on the family. The initial velocity is a smooth standing-wave field of
+!> at Gauss positions (`ppc` a perfect square in 2D, cube in 3D). The grid gets the padding
+!> cells the family asks for on every side (`shape%padding_cells()`: uGIMP and B-splines 1), so
+!> the particle count never depends on the family. The shape and the scheme are named as in a
+!> case file (`lme_g3`, `pc_newmark`) and created through the registry: nothing here knows a
+!> family. The initial velocity is a smooth standing-wave field of
 !> small amplitude (the block is linear elastic and nothing is fixed); Δt is half the CFL limit.
 !> The timed loop calls the integrator's `step` only: no guards, no last-good copy, no output.
 module empm_bench
@@ -14,10 +16,9 @@ module empm_bench
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_USAGE, EMPM_ERR_RUNTIME
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_particle_gen, only: empm_fill, GEOM_BOX, PLACE_GAUSS
-  use empm_shape_factory, only: empm_shape_create
-  use empm_material_factory, only: empm_material_create
+  use empm_namelist, only: empm_kv
+  use empm_registry, only: empm_create_shape, empm_create_material, empm_create_integrator
   use empm_integrator, only: empm_integrator_t
-  use empm_integrator_factory, only: empm_integrator_create
   use empm_solver, only: empm_stable_dt
   use empm_timer, only: PHASE_COUNT, PHASE_NAMES
   use empm_parallel, only: empm_set_threads, empm_max_threads
@@ -35,14 +36,13 @@ module empm_bench
   !> What to run.
   type :: empm_bench_config_t
     integer :: dim = 2                              !! spatial dimension, 2 or 3
-    character(len=16) :: shape = 'linear'           !! linear, ugimp, bspline2, bspline3, lme
-    real(wp) :: gamma = 3.0_wp                      !! LME γ
+    character(len=32) :: shape = 'linear'           !! shape identifier, e.g. linear, lme_g3
     integer :: cells = 64                           !! cells per direction of the block
     integer :: ppc = 4                              !! particles per cell (a perfect power)
     integer :: steps = 50                           !! timed steps
     integer :: warmup = 3                           !! untimed steps first
     integer :: threads = 1                          !! OpenMP threads
-    character(len=16) :: integrator = 'pc_newmark'  !! scheme, see empm_integrator_names
+    character(len=32) :: integrator = 'pc_newmark'  !! scheme name, as in a case file
   end type empm_bench_config_t
 
   !> What was measured (the JSON of `empm bench`, plus a checksum for tests).
@@ -73,6 +73,7 @@ contains
     type(empm_model_t) :: model
     class(empm_integrator_t), allocatable :: integ
     type(empm_step_status_t) :: stat
+    type(empm_error_t) :: e
     real(wp) :: zero3(3), hi(3), origin(3), h(3), dt, s
     integer :: nper, pad, nd, info, nadd, p, d, k, ncell(3)
     integer(int64) :: rss0, rss1, c0, c1, rate
@@ -94,30 +95,27 @@ contains
     call empm_set_threads(cfg%threads)
     rss0 = empm_peak_rss_bytes()
 
-    select case (trim(cfg%shape))
-    case ('ugimp', 'bspline2', 'bspline3'); pad = 1
-    case default; pad = 0
-    end select
+    ! The family first (on a provisional grid: only the dimension matters), for its padding.
     h = 1.0_wp / cfg%cells
+    call model%grid%init(nd, [(0.0_wp, k = 1, nd)], h(1:nd), [(cfg%cells, k = 1, nd)], info)
+    call empm_create_shape(trim(cfg%shape), model%grid, model%shape, e)
+    if (e%code /= 0) then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: --shape: '//e%message, err); return
+    end if
+    pad = model%shape%padding_cells()
     origin = -pad * h
     ncell = cfg%cells + 2 * pad
     call model%grid%init(nd, origin(1:nd), h(1:nd), ncell(1:nd), info)
     if (info /= 0) then
       call empm_raise(EMPM_ERR_USAGE, 'bench: invalid grid', err); return
     end if
-    call empm_shape_create(trim(cfg%shape), nd, model%shape, info, gamma=cfg%gamma)
-    if (info /= 0) then
-      call empm_raise(EMPM_ERR_USAGE, 'bench: unknown shape '''//trim(cfg%shape)// &
-        ''' or invalid --gamma (linear, ugimp, bspline2, bspline3, lme)', err); return
-    end if
-    call empm_integrator_create(trim(cfg%integrator), integ, info)
-    if (info /= 0) then
-      call empm_raise(EMPM_ERR_USAGE, 'bench: unknown integrator '''//trim(cfg%integrator)//'''', &
-                      err); return
+    call empm_create_integrator(trim(cfg%integrator), integ, e)
+    if (e%code /= 0) then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: --integrator: '//e%message, err); return
     end if
     allocate(model%mats(1))
-    call empm_material_create('linear_elastic', BENCH_E, BENCH_NU, BENCH_RHO, &
-                              model%mats(1)%model, info)
+    call empm_create_material('linear_elastic', empm_kv('E', BENCH_E)//empm_kv('nu', BENCH_NU)// &
+                              empm_kv('density', BENCH_RHO), model%mats(1)%model, e)
     ! Exact capacity: no geometric growth (it would double the footprint being measured).
     call model%pts%alloc(nd, cfg%ppc * cfg%cells**nd)
     zero3 = 0.0_wp; hi = 0.0_wp; hi(1:nd) = 1.0_wp

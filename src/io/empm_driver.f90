@@ -1,7 +1,7 @@
 !> High-level driver: read a case file, run it, write the results. Used by the `empm run`
 !> command and callable from embedding codes.
 module empm_driver
-    use empm_error, only: empm_error_t, empm_raise, EMPM_OK
+  use empm_error, only: empm_error_t, empm_raise_error, EMPM_OK
   use empm_case, only: empm_case_t
   use empm_input, only: empm_read_case
   use empm_history, only: empm_history_t
@@ -16,20 +16,23 @@ contains
   !> Run the case in `path`, writing HDF5 to `output` (default: the case's &output file).
   !> Exit-status semantics when `err` is absent: 2 invalid input, 3 run-time guard, 4 I/O.
   !> A run stopped by a guard still writes its last good state, marked incomplete.
-  subroutine empm_run_case(path, output, progress, written, err)
+  subroutine empm_run_case(path, output, progress, written, err, extra_groups)
     character(len=*), intent(in) :: path                !! case file
     character(len=*), intent(in), optional :: output    !! output HDF5 path override
     logical, intent(in), optional :: progress           !! progress line on a terminal (default on)
     character(len=:), allocatable, intent(out), optional :: written !! path of the HDF5 file
     type(empm_error_t), intent(out), optional :: err    !! error, if present
+    character(len=*), intent(in), optional :: extra_groups !! groups of the case file that are
+                                                        !! not the run's (blank-separated, e.g.
+                                                        !! 'verify'): skipped, not rejected
     type(empm_case_t) :: cs
     type(empm_history_t) :: hist
     type(empm_error_t) :: e, ew
     type(empm_output_meta_t) :: meta
 
-    call empm_read_case(path, cs, e)
+    call empm_read_case(path, cs, e, extra_groups=extra_groups)
     if (e%code /= EMPM_OK) then
-      call empm_raise(e%code, e%message, err); return
+      call empm_raise_error(e, err); return
     end if
     if (present(output)) then
       if (len_trim(output) > 0) cs%output_file = trim(output)
@@ -49,10 +52,16 @@ contains
     end if
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then
-      call empm_raise(e%code, e%message//' (last good state written to '//cs%output_file// &
-        ', marked incomplete)', err)
+      ! The guard's error, with its location fields; the message says where the state went.
+      if (ew%code == EMPM_OK) then
+        e%message = e%message//' (last good state written to '//cs%output_file// &
+          ', marked incomplete)'
+      else
+        e%message = e%message//' (and writing the last good state failed: '//ew%message//')'
+      end if
+      call empm_raise_error(e, err)
     else if (ew%code /= EMPM_OK) then
-      call empm_raise(ew%code, ew%message, err)
+      call empm_raise_error(ew, err)
     end if
   end subroutine empm_run_case
 end module empm_driver

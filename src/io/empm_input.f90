@@ -1,693 +1,663 @@
-!> Reads and validates a case file (Fortran namelist groups, one per concern) into an
-!> [[empm_case_t]]. Every key is documented in docs/input.md.
+!> Reads and validates a case file (namelist groups, one per concern) into an [[empm_case_t]].
+!> Every key is documented in docs/input.md, whose key tables are generated from the
+!> declarations here and in the families (`empm keys`).
 !>
-!> Validation is strict: an unknown group or key, a missing required key, a value out of range
-!> or an inconsistent combination gives an error with code EMPM_ERR_INPUT (exit status 2)
-!> naming the file, the group, the key and what was expected.
+!> The file is parsed into groups ([[empm_namelist]]); each group's keys are declared below
+!> (the core groups) or by the family the group selects (shape, material model, integrator,
+!> created through the [[empm_registry]]). The reader knows no family: it passes each group to
+!> the registry. Validation is strict: an unknown group or key, a missing required key, a value
+!> out of range, a group given twice that may appear once, or an inconsistent combination gives
+!> an error with code EMPM_ERR_INPUT (exit status 2) naming the file, the line, the group, the
+!> key and what was expected.
 module empm_input
-  use, intrinsic :: iso_fortran_env, only: iostat_end
   use empm_kinds, only: wp
-  use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_INPUT
-  use empm_strings, only: str, lower
+  use empm_error, only: empm_error_t, empm_raise_error, EMPM_ERR_INPUT, EMPM_OK
+  use empm_strings, only: str
+  use empm_files, only: empm_read_text
+  use empm_params, only: empm_param_t, empm_param, empm_params_markdown, PARAM_REAL, PARAM_INT, &
+                         PARAM_STR, PARAM_LOGICAL
+  use empm_namelist, only: empm_group_t, empm_parse_namelist
   use empm_case, only: empm_case_t, empm_overrides_t
   use empm_model, only: empm_material_slot_t
   use empm_loads, only: RAMP_NONE, RAMP_SINE
   use empm_particle_gen, only: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
   use empm_shape, only: shape_status_text
-  use empm_shape_factory, only: empm_shape_create, empm_shape_names, SHAPE_CREATE_BAD_PARAM
-  use empm_shape_lme, only: empm_shape_lme_t, LME_REMEDY_NONE, LME_REMEDY_ENLARGE
-  use empm_material_factory, only: empm_material_create, material_status_text, MAT_UNKNOWN_NAME
-  use empm_integrator_factory, only: empm_integrator_create, empm_integrator_names
+  use empm_registry, only: empm_registry_t, empm_default_registry
+  use empm_solver, only: empm_run_params
   implicit none
   private
-  public :: empm_read_case
+  public :: empm_read_case, empm_input_markdown, empm_input_group_params
 
-  real(wp), parameter :: UNSET = -huge(1.0_wp)  ! sentinel for required reals
-  integer, parameter :: IUNSET = -huge(1)       ! sentinel for required integers
-  integer, parameter :: MAXSNAP = 1000          ! capacity of output%snapshot_times
   character(len=*), parameter :: GROUPS = 'grid material particles shape integrator loads '// &
-                                          'boundary probe output verify'
+                                          'boundary probe output'
+  character(len=*), parameter :: REPEATABLE = 'material particles boundary probe'
+  integer, parameter :: MAXSNAP = 1000          !! capacity of output%snapshot_times
 
 contains
 
-  !> Read, validate and set up the case in `path`. On error, `err` (or a stop with status 2)
-  !> names the file, group and key.
-  subroutine empm_read_case(path, cs, err, overrides)
-    character(len=*), intent(in) :: path               !! case file
-    type(empm_case_t), intent(inout) :: cs             !! the case, ready to run
-    type(empm_error_t), intent(out), optional :: err   !! error, if present
-    type(empm_overrides_t), intent(in), optional :: overrides !! changes to the file's values
-    type(empm_overrides_t) :: ov
-    integer :: u, ios
-    character(len=512) :: msg
-    character(len=:), allocatable :: emsg
+  ! ---- declarations ------------------------------------------------------------------------
 
-    if (present(overrides)) ov = overrides
-    cs%file = path
-    open(newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
-    if (ios /= 0) then
-      call empm_raise(EMPM_ERR_INPUT, path//': cannot open case file: '//trim(msg), err); return
+  !> The keys of a core group (for the shape, material and integrator groups: the common keys,
+  !> which select the family; the family declares the rest). Empty for an unknown group.
+  function empm_input_group_params(group) result(p)
+    character(len=*), intent(in) :: group    !! group name without '&'
+    type(empm_param_t), allocatable :: p(:)  !! declarations
+    select case (group)
+    case ('grid')
+      p = [ &
+        empm_param('ndim', PARAM_INT, '-', 'spatial dimension: 1 (uniaxial strain), 2 (plane '// &
+          'strain) or 3', lo=1.0_wp, hi=3.0_wp), &
+        empm_param('origin', PARAM_REAL, 'm', 'coordinates of the first node', default='0', &
+          count=3), &
+        empm_param('h', PARAM_REAL, 'm', 'cell size per direction; one value applies to every '// &
+          'direction', count=3, lo=0.0_wp, lo_open=.true.), &
+        empm_param('cells', PARAM_INT, '-', 'number of cells per direction (ndim values)', &
+          count=3, lo=1.0_wp)]
+    case ('material')
+      p = [ &
+        empm_param('name', PARAM_STR, '-', 'label referenced by &particles material (unique)'), &
+        empm_param('model', PARAM_STR, '-', 'material model (see the models below)', &
+          default='''linear_elastic''')]
+    case ('particles')
+      p = [ &
+        empm_param('material', PARAM_STR, '-', 'a &material name'), &
+        empm_param('geometry', PARAM_STR, '-', 'body shape: box (interval in 1D) or disk '// &
+          '(sphere in 3D, ndim >= 2)', default='''box''', choices='box interval disk sphere'), &
+        empm_param('lo', PARAM_REAL, 'm', 'box: lower corner (required for a box)', count=3, &
+          optional=.true.), &
+        empm_param('hi', PARAM_REAL, 'm', 'box: upper corner, hi > lo (required for a box)', &
+          count=3, optional=.true.), &
+        empm_param('center', PARAM_REAL, 'm', 'disk: centre (required for a disk)', count=3, &
+          optional=.true.), &
+        empm_param('radius', PARAM_REAL, 'm', 'disk: radius (required for a disk)', &
+          lo=0.0_wp, lo_open=.true., optional=.true.), &
+        empm_param('ppc', PARAM_INT, '-', 'particles per cell per direction (ppc^ndim per cell)', &
+          default='2', lo=1.0_wp, hi=4.0_wp), &
+        empm_param('placement', PARAM_STR, '-', 'gauss: Gauss-Legendre points, volume = Gauss '// &
+          'weight x cell volume; voxel: centres of ppc^ndim equal sub-cells', &
+          default='''gauss''', choices='gauss voxel'), &
+        empm_param('velocity', PARAM_REAL, 'm/s', 'uniform initial velocity', default='0', &
+          count=3), &
+        empm_param('velocity_sine_amplitude', PARAM_REAL, 'm/s', 'A in v += A sin(k.x + phi)', &
+          default='0', count=3), &
+        empm_param('velocity_sine_wavenumber', PARAM_REAL, '1/m', 'k in the same', &
+          default='0', count=3), &
+        empm_param('velocity_sine_phase', PARAM_REAL, 'rad', 'phi in the same', default='0'), &
+        empm_param('stress', PARAM_REAL, 'Pa', 'uniform initial Cauchy stress, Voigt order '// &
+          'xx, yy, zz, yz, xz, xy', default='0', count=6)]
+    case ('shape')
+      p = [empm_param('family', PARAM_STR, '-', 'shape-function family (see the families '// &
+        'below), or an identifier that also sets tagged parameters, e.g. ''lme_g0.8''', &
+        default='''linear''')]
+    case ('integrator')
+      p = [empm_param('scheme', PARAM_STR, '-', 'time integrator (see the schemes below)', &
+        default='''musl'''), empm_run_params()]
+    case ('loads')
+      p = [ &
+        empm_param('gravity', PARAM_REAL, 'm/s^2', 'gravity vector (final value)', &
+          default='0', count=3), &
+        empm_param('ramp', PARAM_STR, '-', 'none (constant) or sine: the paper''s eq. (46), '// &
+          'g(t) = g (sin(2 pi t/T - pi/2) + 1)/2 for t <= T/2, g after', default='''none''', &
+          choices='none sine'), &
+        empm_param('ramp_time', PARAM_REAL, 's', 'T of eq. (46) (required with ramp = sine)', &
+          lo=0.0_wp, lo_open=.true., optional=.true.)]
+    case ('boundary')
+      p = [ &
+        empm_param('lo', PARAM_REAL, 'm', 'lower corner of the box selecting the nodes', &
+          count=3), &
+        empm_param('hi', PARAM_REAL, 'm', 'upper corner of the box selecting the nodes', &
+          count=3), &
+        empm_param('fix', PARAM_LOGICAL, '-', 'which velocity components are prescribed '// &
+          '(at least one)', default='.false.', count=3), &
+        empm_param('velocity', PARAM_REAL, 'm/s', 'prescribed velocity of the fixed components', &
+          default='0', count=3)]
+    case ('probe')
+      p = [ &
+        empm_param('name', PARAM_STR, '-', 'probe name (HDF5 group /probes/<name>)'), &
+        empm_param('particle', PARAM_INT, '-', 'follow this particle (1-based index in '// &
+          'generation order)', lo=1.0_wp, optional=.true.), &
+        empm_param('point', PARAM_REAL, 'm', 'follow the particle nearest to this point at '// &
+          't = 0', count=3, optional=.true.)]
+    case ('output')
+      p = [ &
+        empm_param('file', PARAM_STR, '-', 'HDF5 output (overridden by empm run -o); '// &
+          'default: the case name + .h5', optional=.true.), &
+        empm_param('history_every', PARAM_INT, '-', 'sample energies and probes every n steps '// &
+          '(and at t_end)', default='1', lo=1.0_wp), &
+        empm_param('snapshot_times', PARAM_REAL, 's', 'increasing times in [0, t_end] at '// &
+          'which the particle state is stored', count=MAXSNAP, lo=0.0_wp, optional=.true.)]
+    case default
+      allocate(p(0))
+    end select
+  end function empm_input_group_params
+
+  !> The generated part of docs/input.md: the key table of every core group, then the families
+  !> of each extension point with their parameters (from `registry`, default the built-ins).
+  function empm_input_markdown(registry) result(s)
+    type(empm_registry_t), intent(in), optional :: registry !! families to document
+    character(len=:), allocatable :: s                      !! Markdown
+    character(len=*), parameter :: NL = new_line('a')
+    type(empm_registry_t) :: reg
+    character(len=16), parameter :: ORDER(9) = [character(len=16) :: 'grid', 'material', &
+      'particles', 'shape', 'integrator', 'loads', 'boundary', 'probe', 'output']
+    integer :: k
+    if (present(registry)) then
+      reg = registry
+    else
+      reg = empm_default_registry()
     end if
-    emsg = ''
-    call slurp(u, cs%text)
-    call check_groups(path, cs%text, emsg)
-    if (len(emsg) == 0) call read_grid(u, path, cs, ov, emsg)
-    if (len(emsg) == 0) call read_materials(u, path, cs, emsg)
-    if (len(emsg) == 0) call read_shape(u, path, cs, ov, emsg)
-    if (len(emsg) == 0) call read_particles(u, path, cs, emsg)
-    if (len(emsg) == 0) call read_integrator(u, path, cs, ov, emsg)
-    if (len(emsg) == 0) call read_loads(u, path, cs, emsg)
-    if (len(emsg) == 0) call read_boundaries(u, path, cs, emsg)
-    if (len(emsg) == 0) call read_probes(u, path, cs, emsg)
-    if (len(emsg) == 0) call read_output(u, path, cs, emsg)
-    close(u)
-    if (len(emsg) == 0) call check_initial_basis(path, cs, emsg)
-    if (len(emsg) > 0) call empm_raise(EMPM_ERR_INPUT, emsg, err)
+    s = ''
+    do k = 1, size(ORDER)
+      s = s//'### `&'//trim(ORDER(k))//'`'//NL//NL// &
+        empm_params_markdown(empm_input_group_params(trim(ORDER(k))))//NL
+      select case (trim(ORDER(k)))
+      case ('material')
+        s = s//'Models (`model`) and their keys:'//NL//NL//reg%markdown('material')
+      case ('shape')
+        s = s//'Families (`family`) and their keys:'//NL//NL//reg%markdown('shape')
+      case ('integrator')
+        s = s//'Schemes (`scheme`) and their keys:'//NL//NL//reg%markdown('integrator')
+      end select
+    end do
+  end function empm_input_markdown
+
+  ! ---- reading -----------------------------------------------------------------------------
+
+  !> Read, validate and set up the case in `path`. On error, `err` (or a stop with status 2)
+  !> names the file, the line, the group and the key. `extra_groups` (blank-separated) are
+  !> groups the caller reads itself (e.g. 'verify'): they are skipped, not rejected.
+  subroutine empm_read_case(path, cs, err, overrides, registry, extra_groups)
+    character(len=*), intent(in) :: path                      !! case file
+    type(empm_case_t), intent(inout) :: cs                    !! the case, ready to run
+    type(empm_error_t), intent(out), optional :: err          !! error, if present
+    type(empm_overrides_t), intent(in), optional :: overrides !! changes to the file's values
+    type(empm_registry_t), intent(in), optional :: registry   !! families (default: built-ins)
+    character(len=*), intent(in), optional :: extra_groups    !! groups read by the caller
+    type(empm_overrides_t) :: ov
+    type(empm_registry_t) :: reg
+    type(empm_group_t), allocatable :: gs(:)
+    type(empm_error_t) :: e
+    character(len=:), allocatable :: extra
+
+    cs = empm_case_t()  ! a case object may be read into again
+    if (present(overrides)) ov = overrides
+    if (present(registry)) then
+      reg = registry
+    else
+      reg = empm_default_registry()
+    end if
+    extra = ''
+    if (present(extra_groups)) extra = extra_groups
+    cs%file = path
+    call empm_read_text(path, cs%text, e)
+    if (e%code /= EMPM_OK) then
+      call e%set(EMPM_ERR_INPUT, 'cannot open case file: '//e%message, file=path)
+      call empm_raise_error(e, err); return
+    end if
+    call empm_parse_namelist(cs%text, path, gs, e)
+    if (e%code == EMPM_OK) call check_groups(path, gs, extra, e)
+    if (e%code == EMPM_OK) call read_grid(path, gs, cs, ov, e)
+    if (e%code == EMPM_OK) call read_materials(path, gs, cs, reg, e)
+    if (e%code == EMPM_OK) call read_shape(gs, cs, ov, reg, e)
+    if (e%code == EMPM_OK) call read_particles(path, gs, cs, e)
+    if (e%code == EMPM_OK) call read_integrator(path, gs, cs, ov, reg, e)
+    if (e%code == EMPM_OK) call read_loads(gs, cs, e)
+    if (e%code == EMPM_OK) call read_boundaries(gs, cs, e)
+    if (e%code == EMPM_OK) call read_probes(gs, cs, e)
+    if (e%code == EMPM_OK) call read_output(path, gs, cs, e)
+    if (e%code == EMPM_OK) call check_initial_basis(path, cs, e)
+    call empm_raise_error(e, err)
   end subroutine empm_read_case
 
   ! ---- helpers ----------------------------------------------------------------------------
 
-  subroutine slurp(u, text)
-    integer, intent(in) :: u
-    character(len=:), allocatable, intent(out) :: text
-    character(len=1024) :: line
-    integer :: ios
-    text = ''
-    do
-      read(u, '(a)', iostat=ios) line
-      if (ios /= 0) exit
-      text = text//trim(line)//new_line('a')
-    end do
-    rewind(u)
-  end subroutine slurp
-
-  !> Valid keys of a group, space-separated ('' for an unknown group).
-  pure function group_keys(group) result(keys)
-    character(len=*), intent(in) :: group
-    character(len=:), allocatable :: keys
-    select case (group)
-    case ('grid'); keys = 'ndim origin h cells'
-    case ('material'); keys = 'name model e nu density'
-    case ('particles'); keys = 'material geometry lo hi center radius ppc placement velocity '// &
-      'velocity_sine_amplitude velocity_sine_wavenumber velocity_sine_phase stress'
-    case ('shape'); keys = 'family gamma tol0 remedy gamma_inside gamma_box_lo gamma_box_hi'
-    case ('integrator'); keys = 'scheme cfl dt t_end max_steps newmark_gamma rho_b'
-    case ('loads'); keys = 'gravity ramp ramp_time'
-    case ('boundary'); keys = 'lo hi fix velocity'
-    case ('probe'); keys = 'name particle point'
-    case ('output'); keys = 'file history_every snapshot_times'
-    case ('verify'); keys = 'benchmark study shapes schemes levels cfls metrics thresholds '// &
-      'min_order max_order expect_fail quick_levels quick'
-    case default; keys = ''
-    end select
-  end function group_keys
-
-  !> Scan the file before the namelist reads: every `&group` must be known, and every `key =`
-  !> inside it must be one of the group's keys. (The namelist reader would skip unknown groups,
-  !> and may report an unknown key as a bad value of the previous array key.)
-  subroutine check_groups(path, text, emsg)
-    character(len=*), intent(in) :: path, text
-    character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: IDCHARS = 'abcdefghijklmnopqrstuvwxyz_0123456789'
-    integer :: i, j, k, lineno, n
-    character(len=:), allocatable :: group, keys, key
-    character(len=1) :: c, quote
-    n = len(text)
-    lineno = 1; group = ''; quote = ' '
-    i = 1
-    do while (i <= n)
-      c = text(i:i)
-      if (c == new_line('a')) lineno = lineno + 1
-      if (quote /= ' ') then
-        if (c == quote) quote = ' '
-      else if (c == '''' .or. c == '"') then
-        quote = c
-      else if (c == '!') then
-        do while (i < n)
-          if (text(i + 1:i + 1) == new_line('a')) exit
-          i = i + 1
-        end do
-      else if (c == '&') then
-        j = i + 1
-        do while (j <= n)
-          if (index(IDCHARS, lower(text(j:j))) == 0) exit
-          j = j + 1
-        end do
-        group = lower(text(i + 1:j - 1))
-        if (len(group) > 0) then
-          if (len(group_keys(group)) == 0) then
-            emsg = path//':'//str(lineno)//': unknown group &'//group//'; expected one of: '// &
-              GROUPS
-            return
-          end if
-        end if
-        i = j - 1
-      else if (c == '/' .and. len(group) > 0) then
-        group = ''
-      else if (len(group) > 0 .and. index(IDCHARS, lower(c)) > 0 .and. &
-               index('0123456789', c) == 0) then
-        ! An identifier inside a group: a key if followed by '=' (optionally after "(...)").
-        j = i
-        do while (j <= n)
-          if (index(IDCHARS, lower(text(j:j))) == 0) exit
-          j = j + 1
-        end do
-        key = lower(text(i:j - 1))
-        k = skip_blanks(j)
-        if (k <= n) then
-          if (text(k:k) == '(') k = skip_blanks(index(text(k:), ')') + k)
-        end if
-        if (k <= n) then
-          if (text(k:k) == '=') then
-            keys = group_keys(group)
-            if (index(' '//keys//' ', ' '//key//' ') == 0) then
-              emsg = path//':'//str(lineno)//': group &'//group//': unknown key '''//key// &
-                '''; valid keys: '//keys
-              return
-            end if
-          end if
-        end if
-        i = j - 1
+  !> Every group must be known (or one of `extra`), and a group that may appear once must not
+  !> appear twice.
+  subroutine check_groups(path, gs, extra, e)
+    character(len=*), intent(in) :: path
+    type(empm_group_t), intent(in) :: gs(:)
+    character(len=*), intent(in) :: extra
+    type(empm_error_t), intent(inout) :: e
+    integer :: i, j
+    do i = 1, size(gs)
+      if (index(' '//extra//' ', ' '//gs(i)%name//' ') > 0) cycle
+      if (index(' '//GROUPS//' ', ' '//gs(i)%name//' ') == 0) then
+        call e%set(EMPM_ERR_INPUT, 'unknown group &'//gs(i)%name//'; expected one of: '// &
+          trim(GROUPS//' '//extra), file=path, line=gs(i)%line)
+        return
       end if
-      i = i + 1
-    end do
-  contains
-    pure integer function skip_blanks(from) result(pos)
-      integer, intent(in) :: from
-      pos = from
-      do while (pos <= n)
-        if (text(pos:pos) /= ' ') exit
-        pos = pos + 1
+      if (index(' '//REPEATABLE//' ', ' '//gs(i)%name//' ') > 0) cycle
+      do j = 1, i - 1
+        if (gs(j)%name == gs(i)%name) then
+          call e%set(EMPM_ERR_INPUT, 'group &'//gs(i)%name//' given twice (first at line '// &
+            str(gs(j)%line)//'); it may appear once', file=path, line=gs(i)%line)
+          return
+        end if
       end do
-    end function skip_blanks
+    end do
   end subroutine check_groups
 
-  !> Message for a failed namelist read (unknown key or malformed value).
-  function nml_error(path, group, keys, msg) result(e)
-    character(len=*), intent(in) :: path, group, keys, msg
-    character(len=:), allocatable :: e
-    e = path//': group &'//group//': '//trim(msg)//' (valid keys: '//keys//')'
-  end function nml_error
+  !> Index of the first group called `name`, 0 if none.
+  pure integer function first(gs, name) result(k)
+    type(empm_group_t), intent(in) :: gs(:)
+    character(len=*), intent(in) :: name
+    do k = 1, size(gs)
+      if (gs(k)%name == name) return
+    end do
+    k = 0
+  end function first
 
-  function req(path, group, key, what) result(e)
-    character(len=*), intent(in) :: path, group, key, what
-    character(len=:), allocatable :: e
-    e = path//': group &'//group//': key '''//key//''': '//what
-  end function req
+  !> The group `name`, or an empty one (so that defaults apply) when absent.
+  subroutine group_or_empty(path, gs, name, g)
+    character(len=*), intent(in) :: path
+    type(empm_group_t), intent(in) :: gs(:)
+    character(len=*), intent(in) :: name
+    type(empm_group_t), intent(out) :: g
+    integer :: k
+    k = first(gs, name)
+    if (k > 0) then
+      g = gs(k)
+    else
+      g%file = path; g%name = name; g%line = 0
+      allocate(g%kv(0))
+    end if
+  end subroutine group_or_empty
+
+  subroutine missing_group(path, name, e)
+    character(len=*), intent(in) :: path, name
+    type(empm_error_t), intent(inout) :: e
+    call e%set(EMPM_ERR_INPUT, 'missing required group &'//name//' (keys: '// &
+      key_list(empm_input_group_params(name))//')', file=path)
+  end subroutine missing_group
+
+  pure function key_list(p) result(s)
+    type(empm_param_t), intent(in) :: p(:)
+    character(len=:), allocatable :: s
+    integer :: i
+    s = ''
+    do i = 1, size(p)
+      if (i > 1) s = s//', '
+      s = s//p(i)%name
+    end do
+  end function key_list
 
   ! ---- groups -----------------------------------------------------------------------------
 
-  subroutine read_grid(u, path, cs, ov, emsg)
-    integer, intent(in) :: u
+  subroutine read_grid(path, gs, cs, ov, e)
     character(len=*), intent(in) :: path
+    type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
     type(empm_overrides_t), intent(in) :: ov
-    character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'ndim, origin, h, cells'
-    integer :: ndim, cells(3), ios, info
+    type(empm_error_t), intent(inout) :: e
+    type(empm_param_t), allocatable :: p(:)
+    type(empm_group_t) :: g
+    integer :: ndim, cells(3), info, n
     real(wp) :: origin(3), h(3)
-    character(len=512) :: msg
-    namelist /grid/ ndim, origin, h, cells
-    ndim = IUNSET; origin = 0.0_wp; h = UNSET; cells = IUNSET
-    rewind(u)
-    read(u, nml=grid, iostat=ios, iomsg=msg)
-    if (ios == iostat_end) then
-      emsg = path//': missing required group &grid (keys: '//K//')'; return
-    else if (ios /= 0) then
-      emsg = nml_error(path, 'grid', K, msg); return
+    if (first(gs, 'grid') == 0) then
+      call missing_group(path, 'grid', e); return
     end if
-    if (ndim == IUNSET) then
-      emsg = req(path, 'grid', 'ndim', 'required: spatial dimension 1, 2 or 3'); return
-    else if (ndim < 1 .or. ndim > 3) then
-      emsg = req(path, 'grid', 'ndim', 'expected 1, 2 or 3, got '//str(ndim)); return
-    end if
-    if (h(1) == UNSET) then
-      emsg = req(path, 'grid', 'h', 'required: cell size [m] (one value or one per direction)')
-      return
-    end if
-    where (h(2:3) == UNSET) h(2:3) = h(1)
-    if (any(h(1:ndim) <= 0.0_wp)) then
-      emsg = req(path, 'grid', 'h', 'expected positive cell sizes, got '//str(minval(h(1:ndim))))
-      return
-    end if
-    if (any(cells(1:ndim) == IUNSET)) then
-      emsg = req(path, 'grid', 'cells', 'required: '//str(ndim)//' cell counts'); return
-    end if
-    if (any(cells(1:ndim) < 1)) then
-      emsg = req(path, 'grid', 'cells', 'expected cell counts >= 1'); return
+    g = gs(first(gs, 'grid'))
+    allocate(p, source=empm_input_group_params('grid'))
+    call g%check_keys(p, e)
+    ndim = 0; origin = 0.0_wp; h = 0.0_wp; cells = 0
+    call g%get(p(1), ndim, e)
+    call g%get(p(2), origin, n, e)
+    call g%get(p(3), h, n, e)
+    if (e%code /= EMPM_OK) return
+    h(max(n, 1) + 1:3) = h(1)  ! one value applies to every direction
+    call g%get(p(4), cells, n, e)
+    if (e%code /= EMPM_OK) return
+    if (n < ndim) then
+      call g%fail(e, 'cells', 'expected '//str(ndim)//' cell counts (one per direction), got '// &
+        str(n)); return
     end if
     h = h / ov%refine; cells = cells * ov%refine
     call cs%model%grid%init(ndim, origin, h, cells, info)
     if (info /= 0) then
       ! Not reachable after the checks above; kept so that no grid error passes silently.
-      emsg = path//': group &grid: invalid grid (grid_init status '//str(info)//')'; return
+      call g%fail(e, '', 'invalid grid (grid_init status '//str(info)//')'); return
     end if
     call cs%model%pts%alloc(ndim, 1024)
   end subroutine read_grid
 
-  subroutine read_materials(u, path, cs, emsg)
-    integer, intent(in) :: u
+  subroutine read_materials(path, gs, cs, reg, e)
     character(len=*), intent(in) :: path
+    type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
-    character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'name, model, E, nu, density'
-    character(len=64) :: name, model
-    real(wp) :: E, nu, density
-    integer :: ios, info, n, i
-    character(len=512) :: msg
+    type(empm_registry_t), intent(in) :: reg
+    type(empm_error_t), intent(inout) :: e
+    type(empm_param_t), allocatable :: p(:)
+    type(empm_group_t) :: g
     type(empm_material_slot_t), allocatable :: tmp(:)
-    namelist /material/ name, model, E, nu, density
-    rewind(u)
+    character(len=:), allocatable :: name, model
+    integer :: k, n, i
+    allocate(p, source=empm_input_group_params('material'))
     allocate(cs%model%mats(0))
     n = 0
-    do
-      name = ''; model = 'linear_elastic'; E = UNSET; nu = 0.0_wp; density = UNSET
-      read(u, nml=material, iostat=ios, iomsg=msg)
-      if (ios == iostat_end) exit
-      if (ios /= 0) then
-        emsg = nml_error(path, 'material', K, msg); return
-      end if
+    do k = 1, size(gs)
+      if (gs(k)%name /= 'material') cycle
+      g = gs(k)
       n = n + 1
-      if (len_trim(name) == 0) then
-        emsg = req(path, 'material', 'name', 'required: a label referenced by &particles '// &
-          '(material number '//str(n)//')'); return
-      end if
+      name = ''; model = 'linear_elastic'
+      call g%get(p(1), name, e)
+      call g%get(p(2), model, e)
+      if (e%code /= EMPM_OK) return
       do i = 1, n - 1
-        if (cs%model%mats(i)%label == trim(name)) then
-          emsg = req(path, 'material', 'name', 'duplicate label '''//trim(name)//''''); return
+        if (cs%model%mats(i)%label == name) then
+          call g%fail(e, 'name', 'duplicate label '''//name//''''); return
         end if
       end do
-      if (E == UNSET) then
-        emsg = req(path, 'material', 'E', 'required: Young''s modulus [Pa] > 0 (material '''// &
-          trim(name)//''')'); return
-      end if
-      if (density == UNSET) then
-        emsg = req(path, 'material', 'density', 'required: density [kg/m3] > 0 (material '''// &
-          trim(name)//''')'); return
-      end if
       allocate(tmp(n))
       do i = 1, n - 1
         call move_alloc(cs%model%mats(i)%model, tmp(i)%model)
         tmp(i)%label = cs%model%mats(i)%label
       end do
       call move_alloc(tmp, cs%model%mats)
-      cs%model%mats(n)%label = trim(name)
-      call empm_material_create(trim(lower(model)), E, nu, density, cs%model%mats(n)%model, info)
-      if (info == MAT_UNKNOWN_NAME) then
-        emsg = req(path, 'material', 'model', 'unknown model '''//trim(model)//''': '// &
-          material_status_text(info)); return
-      else if (info /= 0) then
-        emsg = path//': group &material '''//trim(name)//''': '//material_status_text(info)// &
-          ' (got E = '//str(E)//', nu = '//str(nu)//', density = '//str(density)//')'; return
-      end if
+      cs%model%mats(n)%label = name
+      call reg%create_material(model, cs%model%mats(n)%model, e, g, p)
+      if (e%code /= EMPM_OK) return
     end do
-    if (n == 0) emsg = path//': missing required group &material (keys: '//K//')'
+    if (n == 0) call missing_group(path, 'material', e)
   end subroutine read_materials
 
-  subroutine read_shape(u, path, cs, ov, emsg)
-    integer, intent(in) :: u
-    character(len=*), intent(in) :: path
+  subroutine read_shape(gs, cs, ov, reg, e)
+    type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
     type(empm_overrides_t), intent(in) :: ov
-    character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'family, gamma, tol0, remedy, gamma_inside, '// &
-      'gamma_box_lo, gamma_box_hi'
-    character(len=64) :: family, remedy
-    real(wp) :: gamma, tol0, gamma_inside, gamma_box_lo(3), gamma_box_hi(3)
-    integer :: ios, info, nd
-    logical :: lme_keys
-    character(len=512) :: msg
-    namelist /shape/ family, gamma, tol0, remedy, gamma_inside, gamma_box_lo, gamma_box_hi
-    family = 'linear'; gamma = UNSET; tol0 = UNSET; remedy = ''; gamma_inside = UNSET
-    gamma_box_lo = UNSET; gamma_box_hi = UNSET
-    nd = cs%model%grid%ndim
-    rewind(u)
-    read(u, nml=shape, iostat=ios, iomsg=msg)
-    if (ios /= 0 .and. ios /= iostat_end) then
-      emsg = nml_error(path, 'shape', K, msg); return
+    type(empm_registry_t), intent(in) :: reg
+    type(empm_error_t), intent(inout) :: e
+    type(empm_param_t), allocatable :: p(:)
+    type(empm_group_t) :: g
+    character(len=:), allocatable :: family
+    allocate(p, source=empm_input_group_params('shape'))
+    call group_or_empty(cs%file, gs, 'shape', g)
+    family = 'linear'
+    call g%get(p(1), family, e)
+    if (e%code /= EMPM_OK) return
+    if (allocated(ov%shape)) then
+      ! The study replaces the family: the file's keys of another family do not apply.
+      family = ov%shape
+      call g%keep_only(p)
     end if
-    ! LME keys with another family are an error, unless the family is overridden.
-    lme_keys = gamma /= UNSET .or. tol0 /= UNSET .or. len_trim(remedy) > 0 .or. &
-      gamma_inside /= UNSET .or. any(gamma_box_lo /= UNSET) .or. any(gamma_box_hi /= UNSET)
-    if (lme_keys .and. .not. allocated(ov%shape)) then
-      if (index(lower(adjustl(family)), 'lme') /= 1) then
-        emsg = req(path, 'shape', 'family', 'keys gamma, tol0, remedy and gamma_* apply to '// &
-          'family ''lme'' only, got '''//trim(family)//''''); return
-      end if
-    end if
-    if (allocated(ov%shape)) family = ov%shape
-    if (gamma == UNSET) gamma = 3.0_wp
-    if (tol0 == UNSET) tol0 = 1.0e-6_wp
-    if (.not. (gamma > 0.0_wp)) then
-      emsg = req(path, 'shape', 'gamma', 'expected gamma > 0, got '//str(gamma)); return
-    end if
-    if (.not. (tol0 > 0.0_wp .and. tol0 < 1.0_wp)) then
-      emsg = req(path, 'shape', 'tol0', 'expected 0 < tol0 < 1, got '//str(tol0)); return
-    end if
-    call empm_shape_create(trim(lower(family)), nd, cs%model%shape, info, gamma, tol0)
-    if (info == SHAPE_CREATE_BAD_PARAM) then
-      emsg = req(path, 'shape', 'family', 'expected gamma > 0 in '''//trim(family)//''''); return
-    else if (info /= 0) then
-      emsg = req(path, 'shape', 'family', 'unknown family '''//trim(family)// &
-        '''; expected one of: '//empm_shape_names()//' (or lme_g<gamma>)'); return
-    end if
-    select type (s => cs%model%shape)
-    type is (empm_shape_lme_t)
-      select case (trim(lower(remedy)))
-      case ('', 'none'); s%remedy = LME_REMEDY_NONE
-      case ('enlarge'); s%remedy = LME_REMEDY_ENLARGE
-      case default
-        emsg = req(path, 'shape', 'remedy', 'expected ''none'' or ''enlarge'', got '''// &
-          trim(remedy)//''''); return
-      end select
-      if (gamma_inside /= UNSET) then
-        if (.not. (gamma_inside > 0.0_wp)) then
-          emsg = req(path, 'shape', 'gamma_inside', 'expected > 0, got '//str(gamma_inside))
-          return
-        end if
-        if (any(gamma_box_lo(1:nd) == UNSET) .or. any(gamma_box_hi(1:nd) == UNSET)) then
-          emsg = req(path, 'shape', 'gamma_box_lo/hi', 'required with gamma_inside: '// &
-            str(nd)//' coordinates each [m]'); return
-        end if
-        if (any(gamma_box_hi(1:nd) < gamma_box_lo(1:nd))) then
-          emsg = req(path, 'shape', 'gamma_box_hi', 'expected hi >= lo in every direction')
-          return
-        end if
-        call s%set_gamma_box(cs%model%grid, gamma_box_lo(1:nd), gamma_box_hi(1:nd), &
-                             gamma_inside, info)
-      else if (any(gamma_box_lo /= UNSET) .or. any(gamma_box_hi /= UNSET)) then
-        emsg = req(path, 'shape', 'gamma_inside', 'required with gamma_box_lo/hi: the gamma '// &
-          'of the nodes in the box'); return
-      end if
-    end select
+    call reg%create_shape(family, cs%model%grid, cs%model%shape, e, g, p)
+    if (e%code /= EMPM_OK) return
     cs%shape_name = cs%model%shape%name()
   end subroutine read_shape
 
-  subroutine read_particles(u, path, cs, emsg)
-    integer, intent(in) :: u
+  subroutine read_particles(path, gs, cs, e)
     character(len=*), intent(in) :: path
+    type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
-    character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'material, geometry, lo, hi, center, radius, ppc, '// &
-      'placement, velocity, velocity_sine_amplitude, velocity_sine_wavenumber, '// &
-      'velocity_sine_phase, stress'
-    character(len=64) :: material, geometry, placement
-    real(wp) :: lo(3), hi(3), center(3), radius, velocity(3), velocity_sine_amplitude(3), &
-                velocity_sine_wavenumber(3), velocity_sine_phase, stress(6)
-    integer :: ppc, ios, info, nbody, imat, i, geom, place, nadded, p0, p, nd
-    character(len=512) :: msg
-    namelist /particles/ material, geometry, lo, hi, center, radius, ppc, placement, velocity, &
-      velocity_sine_amplitude, velocity_sine_wavenumber, velocity_sine_phase, stress
+    type(empm_error_t), intent(inout) :: e
+    type(empm_param_t), allocatable :: p(:)
+    type(empm_group_t) :: g
+    character(len=:), allocatable :: material, geometry, placement
+    real(wp) :: lo(3), hi(3), center(3), radius, velocity(3), amp(3), wavenumber(3), phase, &
+                stress(6)
+    integer :: ppc, info, nbody, imat, i, geom, place, nadded, p0, q, nd, k, n, nlo, nhi, nc
+    allocate(p, source=empm_input_group_params('particles'))
     nd = cs%model%grid%ndim
-    rewind(u)
     nbody = 0
-    do
-      material = ''; geometry = 'box'; placement = 'gauss'; ppc = 2
-      lo = UNSET; hi = UNSET; center = UNSET; radius = UNSET
-      velocity = 0.0_wp; velocity_sine_amplitude = 0.0_wp; velocity_sine_wavenumber = 0.0_wp
-      velocity_sine_phase = 0.0_wp; stress = 0.0_wp
-      read(u, nml=particles, iostat=ios, iomsg=msg)
-      if (ios == iostat_end) exit
-      if (ios /= 0) then
-        emsg = nml_error(path, 'particles', K, msg); return
-      end if
+    do k = 1, size(gs)
+      if (gs(k)%name /= 'particles') cycle
+      g = gs(k)
       nbody = nbody + 1
+      call g%check_keys(p, e)
+      material = ''; geometry = 'box'; placement = 'gauss'; ppc = 2
+      lo = 0.0_wp; hi = 0.0_wp; center = 0.0_wp; radius = 0.0_wp
+      velocity = 0.0_wp; amp = 0.0_wp; wavenumber = 0.0_wp; phase = 0.0_wp; stress = 0.0_wp
+      call g%get(p(1), material, e)
+      call g%get(p(2), geometry, e)
+      call g%get(p(3), lo, nlo, e)
+      call g%get(p(4), hi, nhi, e)
+      call g%get(p(5), center, nc, e)
+      call g%get(p(6), radius, e)
+      call g%get(p(7), ppc, e)
+      call g%get(p(8), placement, e)
+      call g%get(p(9), velocity, n, e)
+      call g%get(p(10), amp, n, e)
+      call g%get(p(11), wavenumber, n, e)
+      call g%get(p(12), phase, e)
+      call g%get(p(13), stress, n, e)
+      if (e%code /= EMPM_OK) return
       imat = 0
       do i = 1, size(cs%model%mats)
-        if (cs%model%mats(i)%label == trim(material)) imat = i
+        if (cs%model%mats(i)%label == material) imat = i
       end do
       if (imat == 0) then
-        emsg = req(path, 'particles', 'material', 'expected the name of a &material group, '// &
-          'got '''//trim(material)//''' (body '//str(nbody)//')'); return
+        call g%fail(e, 'material', 'expected the name of a &material group, got '''// &
+          material//''' (body '//str(nbody)//')'); return
       end if
-      select case (trim(lower(geometry)))
+      select case (geometry)
       case ('box', 'interval')
         geom = GEOM_BOX
-        if (any(lo(1:nd) == UNSET) .or. any(hi(1:nd) == UNSET)) then
-          emsg = req(path, 'particles', 'lo/hi', 'required for geometry = ''box'': '// &
-            str(nd)//' coordinates each [m] (body '//str(nbody)//')'); return
+        if (nlo < nd .or. nhi < nd) then
+          call g%fail(e, merge('lo', 'hi', nlo < nd), 'required for geometry = ''box'': '// &
+            str(nd)//' coordinates each of lo and hi [m] (body '//str(nbody)//')'); return
         end if
         if (any(hi(1:nd) <= lo(1:nd))) then
-          emsg = req(path, 'particles', 'hi', 'expected hi > lo in every direction (body '// &
-            str(nbody)//')'); return
+          call g%fail(e, 'hi', 'expected hi > lo in every direction (body '//str(nbody)//')')
+          return
         end if
-      case ('disk', 'sphere')
+      case default
         geom = GEOM_DISK
         if (nd < 2) then
-          emsg = req(path, 'particles', 'geometry', '''disk'' needs ndim >= 2; use ''box'''// &
-            ' (an interval) in 1D'); return
+          call g%fail(e, 'geometry', '''disk'' needs ndim >= 2; use ''box'' (an interval) in 1D')
+          return
         end if
-        if (any(center(1:nd) == UNSET) .or. radius == UNSET .or. radius <= 0.0_wp) then
-          emsg = req(path, 'particles', 'center/radius', 'required for geometry = ''disk'': '// &
-            'a centre and a radius > 0 [m] (body '//str(nbody)//')'); return
+        if (nc < nd .or. .not. g%has('radius')) then
+          call g%fail(e, merge('center', 'radius', nc < nd), 'required for geometry = '// &
+            '''disk'': a centre ('//str(nd)//' coordinates) and a radius > 0 [m] (body '// &
+            str(nbody)//')'); return
         end if
-      case default
-        emsg = req(path, 'particles', 'geometry', 'expected ''box'', ''interval'' or ''disk'','// &
-          ' got '''//trim(geometry)//''''); return
       end select
-      select case (trim(lower(placement)))
-      case ('gauss'); place = PLACE_GAUSS
-      case ('voxel'); place = PLACE_VOXEL
-      case default
-        emsg = req(path, 'particles', 'placement', 'expected ''gauss'' or ''voxel'', got '''// &
-          trim(placement)//''''); return
-      end select
-      if (ppc < 1 .or. ppc > 4) then
-        emsg = req(path, 'particles', 'ppc', 'expected 1..4 particles per cell and direction,'// &
-          ' got '//str(ppc)); return
-      end if
+      place = merge(PLACE_GAUSS, PLACE_VOXEL, placement == 'gauss')
       p0 = cs%model%pts%np
       call empm_fill(cs%model%pts, cs%model%grid, geom, lo, hi, center, radius, ppc, place, &
         cs%model%mats(imat)%model%rho0, imat, nadded, info)
       if (nadded == 0) then
-        emsg = path//': group &particles (body '//str(nbody)//'): the geometry contains no '// &
-          'particle position of the grid: check lo/hi or center/radius against &grid'; return
+        call g%fail(e, '', 'body '//str(nbody)//': the geometry contains no particle '// &
+          'position of the grid: check lo/hi or center/radius against &grid'); return
       end if
-      do p = p0 + 1, p0 + nadded
-        associate (x => cs%model%pts%x(:, p))
-          cs%model%pts%v(:, p) = velocity(1:nd) + velocity_sine_amplitude(1:nd) * &
-            sin(sum(velocity_sine_wavenumber(1:nd) * x) + velocity_sine_phase)
+      do q = p0 + 1, p0 + nadded
+        associate (x => cs%model%pts%x(:, q))
+          cs%model%pts%v(:, q) = velocity(1:nd) + amp(1:nd) * &
+            sin(sum(wavenumber(1:nd) * x) + phase)
         end associate
-        cs%model%pts%stress(:, p) = stress
+        cs%model%pts%stress(:, q) = stress
       end do
     end do
-    if (nbody == 0) emsg = path//': missing required group &particles (keys: '//K//')'
+    if (nbody == 0) call missing_group(path, 'particles', e)
   end subroutine read_particles
 
-  subroutine read_integrator(u, path, cs, ov, emsg)
-    integer, intent(in) :: u
+  subroutine read_integrator(path, gs, cs, ov, reg, e)
     character(len=*), intent(in) :: path
+    type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
     type(empm_overrides_t), intent(in) :: ov
-    character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'scheme, cfl, dt, t_end, max_steps, newmark_gamma, rho_b'
-    character(len=64) :: scheme
-    real(wp) :: cfl, dt, t_end, newmark_gamma, rho_b
-    integer :: max_steps, ios, info
-    character(len=512) :: msg
-    namelist /integrator/ scheme, cfl, dt, t_end, max_steps, newmark_gamma, rho_b
-    scheme = 'musl'; cfl = 0.5_wp; dt = 0.0_wp; t_end = UNSET; max_steps = 100000000
-    newmark_gamma = 0.5_wp; rho_b = 0.8_wp
-    rewind(u)
-    read(u, nml=integrator, iostat=ios, iomsg=msg)
-    if (ios == iostat_end) then
-      emsg = path//': missing required group &integrator (keys: '//K//')'; return
-    else if (ios /= 0) then
-      emsg = nml_error(path, 'integrator', K, msg); return
+    type(empm_registry_t), intent(in) :: reg
+    type(empm_error_t), intent(inout) :: e
+    type(empm_param_t), allocatable :: p(:)
+    type(empm_group_t) :: g
+    character(len=:), allocatable :: scheme
+    real(wp) :: cfl, dt, t_end
+    integer :: max_steps
+    if (first(gs, 'integrator') == 0) then
+      call missing_group(path, 'integrator', e); return
     end if
-    if (allocated(ov%scheme)) scheme = ov%scheme
+    g = gs(first(gs, 'integrator'))
+    allocate(p, source=empm_input_group_params('integrator'))
+    ! Overrides replace the file's values before validation.
+    if (allocated(ov%scheme)) call g%set('scheme', [ov%scheme])
+    if (ov%cfl > 0.0_wp) call g%set('cfl', [str(ov%cfl)])
+    if (ov%dt > 0.0_wp) call g%set('dt', [str(ov%dt)])
+    if (ov%t_end > 0.0_wp) call g%set('t_end', [str(ov%t_end)])
+    scheme = 'musl'; cfl = 0.5_wp; dt = 0.0_wp; t_end = 0.0_wp; max_steps = 100000000
+    call g%get(p(1), scheme, e)
+    call g%get(p(2), t_end, e)
+    call g%get(p(3), cfl, e)
+    call g%get(p(4), dt, e)
+    call g%get(p(5), max_steps, e)
+    if (e%code /= EMPM_OK) return
+    ! Exact override values (their text form above is for validation only).
     if (ov%cfl > 0.0_wp) cfl = ov%cfl
     if (ov%dt > 0.0_wp) dt = ov%dt
     if (ov%t_end > 0.0_wp) t_end = ov%t_end
-    if (.not. (newmark_gamma >= 0.0_wp .and. newmark_gamma <= 1.0_wp)) then
-      emsg = req(path, 'integrator', 'newmark_gamma', 'expected 0 <= newmark_gamma <= 1, got '// &
-        str(newmark_gamma)); return
-    end if
-    if (.not. (rho_b >= 0.0_wp .and. rho_b <= 1.0_wp)) then
-      emsg = req(path, 'integrator', 'rho_b', 'expected 0 <= rho_b <= 1, got '//str(rho_b)); return
-    end if
-    call empm_integrator_create(trim(lower(scheme)), cs%integ, info, newmark_gamma, rho_b)
-    if (info /= 0) then
-      emsg = req(path, 'integrator', 'scheme', 'unknown scheme '''//trim(scheme)// &
-        '''; expected one of: '//empm_integrator_names()); return
-    end if
+    call reg%create_integrator(scheme, cs%integ, e, g, p)
+    if (e%code /= EMPM_OK) return
     cs%scheme_name = cs%integ%name()
-    if (t_end == UNSET) then
-      emsg = req(path, 'integrator', 't_end', 'required: end time [s] > 0'); return
-    else if (t_end <= 0.0_wp) then
-      emsg = req(path, 'integrator', 't_end', 'expected > 0, got '//str(t_end)); return
-    end if
-    if (.not. (cfl > 0.0_wp .and. cfl <= 1.0_wp)) then
-      emsg = req(path, 'integrator', 'cfl', 'expected 0 < cfl <= 1, got '//str(cfl)); return
-    end if
-    if (dt < 0.0_wp) then
-      emsg = req(path, 'integrator', 'dt', 'expected dt >= 0 (0 = from cfl), got '//str(dt))
-      return
-    end if
-    if (max_steps < 1) then
-      emsg = req(path, 'integrator', 'max_steps', 'expected >= 1, got '//str(max_steps)); return
-    end if
     cs%run%t_end = t_end; cs%run%cfl = cfl; cs%run%dt = dt; cs%run%max_steps = max_steps
   end subroutine read_integrator
 
-  subroutine read_loads(u, path, cs, emsg)
-    integer, intent(in) :: u
-    character(len=*), intent(in) :: path
+  subroutine read_loads(gs, cs, e)
+    type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
-    character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'gravity, ramp, ramp_time'
+    type(empm_error_t), intent(inout) :: e
+    type(empm_param_t), allocatable :: p(:)
+    type(empm_group_t) :: g
     real(wp) :: gravity(3), ramp_time
-    character(len=64) :: ramp
-    integer :: ios
-    character(len=512) :: msg
-    namelist /loads/ gravity, ramp, ramp_time
-    gravity = 0.0_wp; ramp = 'none'; ramp_time = UNSET
-    rewind(u)
-    read(u, nml=loads, iostat=ios, iomsg=msg)
-    if (ios /= 0 .and. ios /= iostat_end) then
-      emsg = nml_error(path, 'loads', K, msg); return
-    end if
+    character(len=:), allocatable :: ramp
+    integer :: n, nd
+    allocate(p, source=empm_input_group_params('loads'))
+    call group_or_empty(cs%file, gs, 'loads', g)
+    call g%check_keys(p, e)
+    gravity = 0.0_wp; ramp = 'none'; ramp_time = 0.0_wp
+    call g%get(p(1), gravity, n, e)
+    call g%get(p(2), ramp, e)
+    call g%get(p(3), ramp_time, e)
+    if (e%code /= EMPM_OK) return
+    nd = cs%model%grid%ndim
     cs%model%loads%gravity = 0.0_wp
-    cs%model%loads%gravity(1:cs%model%grid%ndim) = gravity(1:cs%model%grid%ndim)
-    select case (trim(lower(ramp)))
-    case ('none')
-      cs%model%loads%ramp = RAMP_NONE
-    case ('sine')
+    cs%model%loads%gravity(1:nd) = gravity(1:nd)
+    if (ramp == 'sine') then
       cs%model%loads%ramp = RAMP_SINE
-      if (ramp_time == UNSET .or. ramp_time <= 0.0_wp) then
-        emsg = req(path, 'loads', 'ramp_time', 'required with ramp = ''sine'': period T [s] '// &
-          '> 0 of eq. (46)'); return
+      if (.not. g%has('ramp_time')) then
+        call g%fail(e, 'ramp_time', 'required with ramp = ''sine'': period T [s] > 0 of '// &
+          'eq. (46)'); return
       end if
       cs%model%loads%t_ramp = ramp_time
-    case default
-      emsg = req(path, 'loads', 'ramp', 'expected ''none'' or ''sine'', got '''//trim(ramp)//'''')
-      return
-    end select
+    else
+      cs%model%loads%ramp = RAMP_NONE
+    end if
   end subroutine read_loads
 
-  subroutine read_boundaries(u, path, cs, emsg)
-    integer, intent(in) :: u
-    character(len=*), intent(in) :: path
+  subroutine read_boundaries(gs, cs, e)
+    type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
-    character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'lo, hi, fix, velocity'
+    type(empm_error_t), intent(inout) :: e
+    type(empm_param_t), allocatable :: p(:)
+    type(empm_group_t) :: g
     real(wp) :: lo(3), hi(3), velocity(3)
     logical :: fix(3)
-    integer :: ios, nb, nsel, nd
-    character(len=512) :: msg
-    namelist /boundary/ lo, hi, fix, velocity
+    integer :: nb, nsel, nd, k, nlo, nhi, n
+    allocate(p, source=empm_input_group_params('boundary'))
     nd = cs%model%grid%ndim
     call cs%model%nodes%alloc(cs%model%grid)
-    rewind(u)
     nb = 0
-    do
-      lo = UNSET; hi = UNSET; fix = .false.; velocity = 0.0_wp
-      read(u, nml=boundary, iostat=ios, iomsg=msg)
-      if (ios == iostat_end) exit
-      if (ios /= 0) then
-        emsg = nml_error(path, 'boundary', K, msg); return
-      end if
+    do k = 1, size(gs)
+      if (gs(k)%name /= 'boundary') cycle
+      g = gs(k)
       nb = nb + 1
-      if (any(lo(1:nd) == UNSET) .or. any(hi(1:nd) == UNSET)) then
-        emsg = req(path, 'boundary', 'lo/hi', 'required: the box selecting the nodes, '// &
-          str(nd)//' coordinates each [m] (boundary '//str(nb)//')'); return
+      call g%check_keys(p, e)
+      lo = 0.0_wp; hi = 0.0_wp; fix = .false.; velocity = 0.0_wp
+      call g%get(p(1), lo, nlo, e)
+      call g%get(p(2), hi, nhi, e)
+      call g%get(p(3), fix, n, e)
+      call g%get(p(4), velocity, n, e)
+      if (e%code /= EMPM_OK) return
+      if (nlo < nd .or. nhi < nd) then
+        call g%fail(e, merge('lo', 'hi', nlo < nd), 'required: the box selecting the nodes, '// &
+          str(nd)//' coordinates each of lo and hi [m] (boundary '//str(nb)//')'); return
       end if
       if (.not. any(fix(1:nd))) then
-        emsg = req(path, 'boundary', 'fix', 'expected at least one .true. component '// &
-          '(boundary '//str(nb)//')'); return
+        call g%fail(e, 'fix', 'expected at least one .true. component (boundary '//str(nb)//')')
+        return
       end if
       call cs%model%nodes%fix_box(cs%model%grid, lo, hi, fix, velocity, nsel)
       if (nsel == 0) then
-        emsg = req(path, 'boundary', 'lo/hi', 'the box selects no grid node (boundary '// &
-          str(nb)//'): nodes lie at origin + i*h'); return
+        call g%fail(e, 'lo', 'the box [lo, hi] selects no grid node (boundary '//str(nb)// &
+          '): nodes lie at origin + i*h'); return
       end if
     end do
   end subroutine read_boundaries
 
-  subroutine read_probes(u, path, cs, emsg)
-    integer, intent(in) :: u
-    character(len=*), intent(in) :: path
+  subroutine read_probes(gs, cs, e)
+    type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
-    character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'name, particle, point'
-    character(len=64) :: name
-    integer :: particle, ios, n, nd, p
+    type(empm_error_t), intent(inout) :: e
+    type(empm_param_t), allocatable :: p(:)
+    type(empm_group_t) :: g
+    character(len=:), allocatable :: name
+    integer :: particle, n, nd, q, k, npt
     real(wp) :: point(3)
-    character(len=512) :: msg
     character(len=64), allocatable :: names(:)
     integer, allocatable :: parts(:)
-    namelist /probe/ name, particle, point
+    allocate(p, source=empm_input_group_params('probe'))
     nd = cs%model%grid%ndim
     allocate(names(0), parts(0))
-    rewind(u)
     n = 0
-    do
-      name = ''; particle = IUNSET; point = UNSET
-      read(u, nml=probe, iostat=ios, iomsg=msg)
-      if (ios == iostat_end) exit
-      if (ios /= 0) then
-        emsg = nml_error(path, 'probe', K, msg); return
-      end if
+    do k = 1, size(gs)
+      if (gs(k)%name /= 'probe') cycle
+      g = gs(k)
       n = n + 1
-      if (len_trim(name) == 0) then
-        emsg = req(path, 'probe', 'name', 'required (probe '//str(n)//')'); return
+      call g%check_keys(p, e)
+      name = ''; particle = 0; point = 0.0_wp
+      call g%get(p(1), name, e)
+      call g%get(p(2), particle, e)
+      call g%get(p(3), point, npt, e)
+      if (e%code /= EMPM_OK) return
+      if (len(name) > 64) then
+        call g%fail(e, 'name', 'expected at most 64 characters, got '''//name//''''); return
       end if
       if (any(names == name)) then
-        emsg = req(path, 'probe', 'name', 'duplicate probe name '''//trim(name)//''''); return
+        call g%fail(e, 'name', 'duplicate probe name '''//name//''''); return
       end if
-      if ((particle == IUNSET) .eqv. (point(1) == UNSET)) then
-        emsg = req(path, 'probe', 'particle/point', 'give exactly one of particle (index) '// &
-          'or point (coordinates) for probe '''//trim(name)//''''); return
+      if (g%has('particle') .eqv. g%has('point')) then
+        call g%fail(e, 'particle', 'give exactly one of particle (index) or point '// &
+          '(coordinates) for probe '''//name//''''); return
       end if
-      if (particle /= IUNSET) then
-        if (particle < 1 .or. particle > cs%model%pts%np) then
-          emsg = req(path, 'probe', 'particle', 'expected 1..'//str(cs%model%pts%np)// &
-            ', got '//str(particle)); return
+      if (g%has('particle')) then
+        if (particle > cs%model%pts%np) then
+          call g%fail(e, 'particle', 'expected 1..'//str(cs%model%pts%np)//', got '// &
+            str(particle)); return
         end if
-        p = particle
+        q = particle
       else
-        if (any(point(1:nd) == UNSET)) then
-          emsg = req(path, 'probe', 'point', 'expected '//str(nd)//' coordinates'); return
+        if (npt < nd) then
+          call g%fail(e, 'point', 'expected '//str(nd)//' coordinates'); return
         end if
         ! A point probe follows the material point nearest to it at t = 0.
-        p = minloc(sum((cs%model%pts%x(:, 1:cs%model%pts%np) - &
+        q = minloc(sum((cs%model%pts%x(:, 1:cs%model%pts%np) - &
                    spread(point(1:nd), 2, cs%model%pts%np))**2, dim=1), dim=1)
       end if
-      names = [character(len=64) :: names, name]; parts = [parts, p]
+      names = [character(len=64) :: names, name]; parts = [parts, q]
     end do
     call move_alloc(names, cs%probe_name); call move_alloc(parts, cs%probe_particle)
   end subroutine read_probes
 
-  subroutine read_output(u, path, cs, emsg)
-    integer, intent(in) :: u
+  subroutine read_output(path, gs, cs, e)
     character(len=*), intent(in) :: path
+    type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
-    character(len=:), allocatable, intent(inout) :: emsg
-    character(len=*), parameter :: K = 'file, history_every, snapshot_times'
-    character(len=512) :: file, msg
-    integer :: history_every, ios, n, i
+    type(empm_error_t), intent(inout) :: e
+    type(empm_param_t), allocatable :: p(:)
+    type(empm_group_t) :: g
+    character(len=:), allocatable :: file
+    integer :: history_every, n, i
     real(wp) :: snapshot_times(MAXSNAP)
-    namelist /output/ file, history_every, snapshot_times
-    file = ''; history_every = 1; snapshot_times = UNSET
-    rewind(u)
-    read(u, nml=output, iostat=ios, iomsg=msg)
-    if (ios /= 0 .and. ios /= iostat_end) then
-      emsg = nml_error(path, 'output', K, msg); return
-    end if
-    if (history_every < 1) then
-      emsg = req(path, 'output', 'history_every', 'expected >= 1, got '//str(history_every))
-      return
-    end if
-    n = count(snapshot_times /= UNSET)
-    if (any(snapshot_times(1:n) == UNSET)) then
-      emsg = req(path, 'output', 'snapshot_times', 'expected consecutive values from index 1')
-      return
-    end if
+    allocate(p, source=empm_input_group_params('output'))
+    call group_or_empty(path, gs, 'output', g)
+    call g%check_keys(p, e)
+    file = ''; history_every = 1; snapshot_times = 0.0_wp
+    call g%get(p(1), file, e)
+    call g%get(p(2), history_every, e)
+    call g%get(p(3), snapshot_times, n, e)
+    if (e%code /= EMPM_OK) return
     do i = 1, n
-      if (snapshot_times(i) < 0.0_wp .or. snapshot_times(i) > cs%run%t_end .or. &
+      if (snapshot_times(i) > cs%run%t_end .or. &
           (i > 1 .and. snapshot_times(max(i - 1, 1)) >= snapshot_times(i))) then
-        emsg = req(path, 'output', 'snapshot_times', 'expected increasing times in [0, t_end]'// &
-          ', got '//str(snapshot_times(i))//' at index '//str(i)); return
+        call g%fail(e, 'snapshot_times', 'expected increasing times in [0, t_end], got '// &
+          str(snapshot_times(i))//' at index '//str(i)); return
       end if
     end do
     cs%run%snapshot_times = snapshot_times(1:n)
@@ -712,13 +682,14 @@ contains
 
   !> Finish the set-up and evaluate the shape functions once: a particle whose support does not
   !> fit the grid is an input error, reported before any step is taken.
-  subroutine check_initial_basis(path, cs, emsg)
+  subroutine check_initial_basis(path, cs, e)
     character(len=*), intent(in) :: path
     type(empm_case_t), intent(inout) :: cs
-    character(len=:), allocatable, intent(inout) :: emsg
+    type(empm_error_t), intent(inout) :: e
     integer :: ibad, info, d
     character(len=:), allocatable :: xs
-    call cs%model%finalize_setup()
+    call cs%model%finalize_setup(e)
+    if (e%code /= EMPM_OK) return
     call cs%model%shape%eval_batch(cs%model%grid, cs%model%pts, cs%model%basis, ibad, info)
     if (info /= 0) then
       xs = ''
@@ -728,8 +699,9 @@ contains
         end do
         xs = ' at x ='//xs//')'
       end if
-      emsg = path//': groups &grid/&particles/&shape are inconsistent: at particle '// &
-        str(ibad)//xs//' the '//cs%shape_name//' shape functions fail: '//shape_status_text(info)
+      call e%set(EMPM_ERR_INPUT, 'groups &grid/&particles/&shape are inconsistent: at '// &
+        'particle '//str(ibad)//xs//' the '//cs%shape_name//' shape functions fail: '// &
+        shape_status_text(info), file=path, particle=ibad)
     end if
   end subroutine check_initial_basis
 end module empm_input

@@ -3,7 +3,11 @@
 !> The file is written under a temporary name (`OUT.partial`) and renamed when complete, so an
 !> interrupted run never leaves a file that looks complete. A run stopped by a guard is still
 !> written, with the last good state and the root attribute `complete = 0`.
+!>
+!> The materials' state variables are written by name (`state/<name>`, one value per particle),
+!> NaN for the particles whose material does not declare that name.
 module empm_output
+  use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use hdf5, only: h5open_f, h5fcreate_f, h5fclose_f, H5F_ACC_TRUNC_F
   use empm_kinds, only: wp
   use empm_h5, only: hid_t, h5_group, h5_close_group, h5_write, h5_attr
@@ -11,6 +15,7 @@ module empm_output
   use empm_files, only: empm_rename, empm_remove
   use empm_version_info, only: empm_version
   use empm_model, only: empm_model_t
+  use empm_material, only: STATE_NAME_LEN
   use empm_history, only: empm_history_t
   use empm_particles, only: empm_particles_t
   implicit none
@@ -39,11 +44,14 @@ contains
     character(len=*), intent(in) :: status             !! '' or the message that stopped it
     type(empm_error_t), intent(out), optional :: err   !! error, if present
     integer(hid_t) :: fid, g, gs, gp
-    integer :: ierr, e, k, info
+    integer :: ierr, e, k, info, n
     character(len=:), allocatable :: tmp
     character(len=16) :: sname
+    character(len=STATE_NAME_LEN), allocatable :: snames(:)
+    integer, allocatable :: scol(:,:)
     tmp = path//'.partial'
     ierr = 0
+    call state_columns(model, snames, scol)
     call h5open_f(e)
     call h5fcreate_f(tmp, H5F_ACC_TRUNC_F, fid, e)
     if (e /= 0) then
@@ -73,6 +81,7 @@ contains
     call h5_attr(g, 'time', model%t, ierr)
     call h5_attr(g, 'step', model%step, ierr)
     call write_state(g, model%pts, ierr)
+    call write_state_vars(g, model%pts%state, model%pts%mat, snames, scol, ierr)
     call h5_close_group(g, ierr)
 
     call h5_group(fid, 'snapshots', gs, ierr)
@@ -89,6 +98,10 @@ contains
       call h5_write(g, 'mass', hist%snap(k)%m, ierr)
       call h5_write(g, 'volume', hist%snap(k)%vol, ierr)
       call h5_write(g, 'density', hist%snap(k)%rho, ierr)
+      ! Particles keep their material for the whole run: the current indices apply.
+      n = min(size(hist%snap(k)%m), model%pts%np)
+      if (allocated(hist%snap(k)%state)) call write_state_vars(g, hist%snap(k)%state(:, 1:n), &
+        model%pts%mat(1:n), snames, scol, ierr)
       call h5_close_group(g, ierr)
     end do
     call h5_close_group(gs, ierr)
@@ -118,7 +131,7 @@ contains
       info = empm_remove(tmp)
       call empm_raise(EMPM_ERR_IO, path//': writing the HDF5 output failed', err); return
     end if
-    call write_xdmf(path, model, hist, ierr)
+    call write_xdmf(path, model, hist, snames, ierr)
     if (ierr /= 0) then
       info = empm_remove(tmp)
       call empm_raise(EMPM_ERR_IO, path//': cannot write the XDMF file', err); return
@@ -147,6 +160,69 @@ contains
     call h5_write(g, 'material', pts%mat(1:n), ierr)
   end subroutine write_state
 
+  !> The state-variable names of all materials (each once, in material order) and, for name k
+  !> and material m, the row `col(k, m)` of `pts%state` holding it (0: m does not declare it).
+  subroutine state_columns(model, names, col)
+    type(empm_model_t), intent(in) :: model
+    character(len=STATE_NAME_LEN), allocatable, intent(out) :: names(:)
+    integer, allocatable, intent(out) :: col(:,:)
+    character(len=STATE_NAME_LEN), allocatable :: own(:)
+    integer :: nmat, m, j, k
+    allocate(names(0))
+    nmat = 0
+    if (allocated(model%mats)) nmat = size(model%mats)
+    do m = 1, nmat
+      if (.not. allocated(model%mats(m)%model)) cycle
+      call model%mats(m)%model%state_names(own)
+      do j = 1, size(own)
+        if (.not. any(names == own(j))) names = [character(len=STATE_NAME_LEN) :: names, own(j)]
+      end do
+    end do
+    allocate(col(size(names), nmat))
+    col = 0
+    do m = 1, nmat
+      if (.not. allocated(model%mats(m)%model)) cycle
+      call model%mats(m)%model%state_names(own)
+      do j = 1, size(own)
+        do k = 1, size(names)
+          if (names(k) == own(j)) col(k, m) = j
+        end do
+      end do
+    end do
+  end subroutine state_columns
+
+  !> Group `state` under `g`: one dataset (np) per name, NaN where the particle's material does
+  !> not declare the name. Nothing when no material has state variables.
+  subroutine write_state_vars(g, state, mat, names, col, ierr)
+    integer(hid_t), intent(in) :: g
+    real(wp), intent(in) :: state(:,:)
+    integer, intent(in) :: mat(:)
+    character(len=*), intent(in) :: names(:)
+    integer, intent(in) :: col(:,:)
+    integer, intent(inout) :: ierr
+    integer(hid_t) :: gs
+    real(wp), allocatable :: buf(:)
+    real(wp) :: nan
+    integer :: k, p, r
+    if (size(names) == 0) return
+    nan = ieee_value(1.0_wp, ieee_quiet_nan)
+    allocate(buf(size(mat)))
+    call h5_group(g, 'state', gs, ierr)
+    do k = 1, size(names)
+      do p = 1, size(mat)
+        r = 0
+        if (mat(p) >= 1 .and. mat(p) <= size(col, 2)) r = col(k, mat(p))
+        if (r >= 1 .and. r <= size(state, 1)) then
+          buf(p) = state(r, p)
+        else
+          buf(p) = nan
+        end if
+      end do
+      call h5_write(gs, trim(names(k)), buf, ierr)
+    end do
+    call h5_close_group(gs, ierr)
+  end subroutine write_state_vars
+
   !> Positions padded to three components (what ParaView's XDMF reader needs).
   pure function pad3(x) result(y)
     real(wp), intent(in) :: x(:,:)
@@ -155,11 +231,13 @@ contains
     y(1:size(x, 1), :) = x
   end function pad3
 
-  !> XDMF 2 temporal collection of the snapshots and the final state (particles as vertices).
-  subroutine write_xdmf(path, model, hist, ierr)
+  !> XDMF 2 temporal collection of the snapshots and the final state (particles as vertices),
+  !> with one scalar attribute per state variable.
+  subroutine write_xdmf(path, model, hist, snames, ierr)
     character(len=*), intent(in) :: path
     type(empm_model_t), intent(in) :: model
     type(empm_history_t), intent(in) :: hist
+    character(len=*), intent(in) :: snames(:)
     integer, intent(inout) :: ierr
     integer :: u, k, ios, s
     character(len=:), allocatable :: xmf, h5name
@@ -195,6 +273,7 @@ contains
       integer, intent(in) :: np
       character(len=*), intent(in) :: grp
       character(len=32) :: cnp, ct
+      integer :: j
       write(cnp, '(i0)') np
       write(ct, '(es24.16)') t
       write(u, '(a)') '   <Grid Name="t" GridType="Uniform">'
@@ -207,6 +286,9 @@ contains
       call attribute('velocity', 'Vector', grp//'/v', trim(cnp)//' '//dimstr(model%grid%ndim))
       call attribute('stress', 'Tensor6', grp//'/stress', trim(cnp)//' 6')
       call attribute('density', 'Scalar', grp//'/density', trim(cnp))
+      do j = 1, size(snames)
+        call attribute(trim(snames(j)), 'Scalar', grp//'/state/'//trim(snames(j)), trim(cnp))
+      end do
       write(u, '(a)') '   </Grid>'
     end subroutine grid_entry
     subroutine attribute(name, kind, ds, dims)

@@ -3,7 +3,9 @@ module empm_solver
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use empm_kinds, only: wp
-  use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_RUNTIME, EMPM_ERR_USAGE
+  use empm_params, only: empm_param_t, empm_param, PARAM_REAL, PARAM_INT
+  use empm_error, only: empm_error_t, empm_raise, empm_raise_error, empm_alloc_error, &
+                        EMPM_ERR_RUNTIME, EMPM_ERR_USAGE
   use empm_strings, only: str, join
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK, STEP_SHAPE_FAILED
   use empm_integrator, only: empm_integrator_t
@@ -13,6 +15,7 @@ module empm_solver
   use empm_terminal, only: stderr_is_terminal
   implicit none
   private
+  public :: empm_run_params
   public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies, empm_check_guards
 
   !> How to run: end time, time step control, output sampling.
@@ -27,6 +30,20 @@ module empm_solver
   end type empm_run_config_t
 
 contains
+
+  !> The run controls of the `&integrator` group (t_end, cfl, dt, max_steps), declared here
+  !> where they are used; the case reader reads them, the scheme its own keys.
+  pure function empm_run_params() result(p)
+    type(empm_param_t), allocatable :: p(:) !! declarations
+    p = [ &
+      empm_param('t_end', PARAM_REAL, 's', 'end time', lo=0.0_wp, lo_open=.true.), &
+      empm_param('cfl', PARAM_REAL, '-', 'Courant number: dt = cfl h_min / c_max', &
+        default='0.5', lo=0.0_wp, hi=1.0_wp, lo_open=.true.), &
+      empm_param('dt', PARAM_REAL, 's', 'fixed time step; 0 = from cfl (a fixed step above '// &
+        'the stability limit stops the run, status 3)', default='0', lo=0.0_wp), &
+      empm_param('max_steps', PARAM_INT, '-', 'safety cap on the number of steps (reaching '// &
+        'it stops the run, status 3)', default='100000000', lo=1.0_wp)]
+  end function empm_run_params
 
   !> Largest stable time step h_min / c_max, with c_max the largest P-wave speed over the
   !> particles (wave speeds are non-increasing in density, so each material run is evaluated
@@ -60,7 +77,8 @@ contains
     do r = 1, size(model%run_first)
       i0 = model%run_first(r); i1 = model%run_last(r)
       call model%mats(model%pts%mat(i0))%model%energy_density(model%pts%F(:, :, i0:i1), &
-        model%pts%strain(:, i0:i1), model%pts%stress(:, i0:i1), psi(i0:i1))
+        model%pts%strain(:, i0:i1), model%pts%stress(:, i0:i1), model%pts%state(:, i0:i1), &
+        psi(i0:i1))
       estrain = estrain + sum(model%pts%vol(i0:i1) * psi(i0:i1))
     end do
     g = model%loads%gravity_at(model%t)
@@ -84,6 +102,9 @@ contains
     integer(int64) :: clock0, clock_last, clock, rate
     logical :: show
     character(len=:), allocatable :: msg
+    type(empm_error_t) :: e
+    integer :: astat
+    character(len=256) :: amsg
 
     if (.not. allocated(model%run_first)) then
       call empm_raise(EMPM_ERR_USAGE, 'empm_solve: call model%finalize_setup() first', err); return
@@ -92,9 +113,15 @@ contains
       call empm_raise(EMPM_ERR_USAGE, 'empm_solve: t_end must exceed the current time', err)
       return
     end if
-    call integ%prepare(model)
-    allocate(psi(model%pts%np))
-    call good%alloc(model%grid%ndim, model%pts%np)
+    call integ%prepare(model, e)
+    if (e%code == 0) call good%alloc(model%grid%ndim, model%pts%np, model%pts%nstate, e)
+    if (e%code == 0) then
+      allocate(psi(model%pts%np), stat=astat, errmsg=amsg)
+      if (astat /= 0) e = empm_alloc_error('energy scratch', 8_int64 * model%pts%np, amsg)
+    end if
+    if (e%code /= 0) then
+      call empm_raise_error(e, err); return
+    end if
     nsnap = 0
     if (allocated(cfg%snapshot_times)) nsnap = size(cfg%snapshot_times)
     isnap = 1
@@ -131,7 +158,7 @@ contains
       model%step = model%step + 1
       if (stat%code /= STEP_OK) then
         msg = describe_status(stat)
-        call restore(); call fail(msg); return
+        call restore(); call fail(msg, stat%particle); return
       end if
       model%t = model%t + dt
       msg = empm_check_guards(model)
@@ -163,10 +190,16 @@ contains
       model%t = t_good; model%step = step_good
     end subroutine restore
 
-    subroutine fail(text)
+    ! The run-time error: the text already names the step (and the particle or node); the
+    ! fields carry them for programs.
+    subroutine fail(text, particle)
       character(len=*), intent(in) :: text
+      integer, intent(in), optional :: particle
+      type(empm_error_t) :: ef
       if (show) write(error_unit, '(a)') ''
-      call empm_raise(EMPM_ERR_RUNTIME, text, err)
+      ef%code = EMPM_ERR_RUNTIME; ef%message = text; ef%step = model%step + 1
+      if (present(particle)) ef%particle = particle
+      call empm_raise_error(ef, err)
     end subroutine fail
 
     subroutine progress()
@@ -195,15 +228,17 @@ contains
         if (s%detail == SHAPE_OUTSIDE_GRID) text = 'step '//str(model%step)//': particle '//str(s%particle)// &
           ' left the grid: x = '//vec(model%pts%x(:, p))
       else
+        ! The material says why its update fails (the owner of the status explains it).
         text = 'step '//str(model%step)//': stress update failed at particle '// &
-          str(s%particle)//' (material '//str(s%detail)// &
-          '): its volume ratio became <= 0 (e.g. det F <= 0: the particle is inverted)'
+          str(s%particle)//' (material '''//model%mats(s%detail)%label//''', model '// &
+          model%mats(s%detail)%model%name()//'): '//model%mats(s%detail)%model%failure_text()
       end if
     end function describe_status
   end subroutine empm_solve
 
-  !> Check particle and nodal fields after a step; returns '' when all is well, otherwise a
-  !> message naming the step, the particle or node and the quantity.
+  !> Check particle and nodal fields after a step (state variables included: they must stay
+  !> finite); returns '' when all is well, otherwise a message naming the step, the particle or
+  !> node and the quantity.
   function empm_check_guards(model) result(msg)
     type(empm_model_t), intent(in) :: model !! simulation state
     character(len=:), allocatable :: msg    !! '' or the first problem found
@@ -221,6 +256,8 @@ contains
           msg = 'non-finite stress'
         else if (.not. all(ieee_is_finite(pts%strain(:, p)))) then
           msg = 'non-finite strain'
+        else if (.not. all(ieee_is_finite(pts%state(:, p)))) then
+          msg = 'non-finite state variable '//state_label(p)
         else if (.not. (ieee_is_finite(pts%rho(p)) .and. pts%rho(p) > 0.0_wp)) then
           msg = 'non-finite or non-positive density'
         else if (.not. (ieee_is_finite(pts%vol(p)) .and. pts%vol(p) > 0.0_wp)) then
@@ -247,6 +284,22 @@ contains
         return
       end if
     end do
+  contains
+    ! 'k' or, when the particle's material names its row k, 'k (name)'.
+    function state_label(p) result(t)
+      use empm_material, only: STATE_NAME_LEN
+      integer, intent(in) :: p
+      character(len=:), allocatable :: t
+      character(len=STATE_NAME_LEN), allocatable :: names(:)
+      integer :: k, im
+      k = findloc(ieee_is_finite(model%pts%state(:, p)), .false., dim=1)
+      t = str(k)
+      im = model%pts%mat(p)
+      if (.not. allocated(model%mats)) return
+      if (im < 1 .or. im > size(model%mats)) return
+      call model%mats(im)%model%state_names(names)
+      if (k <= size(names)) t = t//' ('//trim(names(k))//')'
+    end function state_label
   end function empm_check_guards
 
   pure function vec(x) result(s)

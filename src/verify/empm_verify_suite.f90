@@ -154,7 +154,7 @@ contains
       type(empm_output_meta_t) :: meta
       integer :: ierr
       ran = .false.; msg = ''
-      call empm_read_case(spec%file, cs, e, ov)
+      call empm_read_case(spec%file, cs, e, ov, extra_groups='verify')
       if (e%code /= EMPM_OK) then
         msg = e%message; return
       end if
