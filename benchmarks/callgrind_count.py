@@ -6,7 +6,8 @@ Two runs of the same case that differ only in the number of timed steps (N1 and 
 same warm-up) are counted; their difference divided by (N2 - N1) * particles removes set-up,
 warm-up and output. The per-function split of that difference shows where the instructions go.
 
-Usage: callgrind_count.py EMPM SHAPE [GAMMA]   (prints one JSON object)
+Usage: callgrind_count.py EMPM SHAPE   (prints one JSON object)
+SHAPE is a shape identifier as in a case file: linear, ..., lme (gamma 3), lme_g<gamma>.
 Case: 2D, 32x32 cells, 4 particles per cell (4096 particles), 2 warm-up steps, 1 thread,
 N1 = 2 and N2 = 6 timed steps; pc_newmark.
 """
@@ -20,10 +21,10 @@ from pathlib import Path
 CELLS, PPC, WARMUP, N1, N2 = 32, 4, 2, 2, 6
 
 
-def count(empm, shape, gamma, steps, outdir):
+def count(empm, shape, steps, outdir):
     out = Path(outdir) / f"cg.{steps}"
     cmd = ["valgrind", "--tool=callgrind", f"--callgrind-out-file={out}", empm, "bench",
-           "--dim", "2", "--shape", shape, "--gamma", gamma, "--cells", str(CELLS),
+           "--dim", "2", "--shape", shape, "--cells", str(CELLS),
            "--ppc", str(PPC), "--warmup", str(WARMUP), "--steps", str(steps), "--threads", "1"]
     run = subprocess.run(cmd, capture_output=True, text=True, check=True)
     bench = json.loads(run.stdout.strip().splitlines()[-1])
@@ -47,11 +48,12 @@ def count(empm, shape, gamma, steps, outdir):
 
 
 def main():
+    if len(sys.argv) != 3:
+        sys.exit("usage: callgrind_count.py EMPM SHAPE   (SHAPE e.g. linear, lme_g3)")
     empm, shape = sys.argv[1], sys.argv[2]
-    gamma = sys.argv[3] if len(sys.argv) > 3 else "3"
     with tempfile.TemporaryDirectory() as tmp:
-        t1, f1, _ = count(empm, shape, gamma, N1, tmp)
-        t2, f2, bench = count(empm, shape, gamma, N2, tmp)
+        t1, f1, _ = count(empm, shape, N1, tmp)
+        t2, f2, bench = count(empm, shape, N2, tmp)
     den = (N2 - N1) * bench["particles"]
     split = {k: (f2.get(k, 0) - f1.get(k, 0)) / den for k in set(f1) | set(f2)}
     split = dict(sorted(((k, round(v, 1)) for k, v in split.items() if abs(v) >= 5.0),

@@ -23,12 +23,12 @@ program lme_bench
   use empm_particles, only: empm_particles_t
   use empm_shape, only: empm_basis_t, SHAPE_OK
   use empm_shape_lme, only: empm_shape_lme_t, lme_format_gamma
-  use empm_shape_factory, only: empm_shape_create
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_particle_gen, only: empm_fill, GEOM_BOX, PLACE_GAUSS
-  use empm_material_factory, only: empm_material_create
   use empm_integrator, only: empm_integrator_t
-  use empm_integrator_factory, only: empm_integrator_create
+  use empm_registry, only: empm_create_shape, empm_create_material, empm_create_integrator
+  use empm_namelist, only: empm_kv
+  use empm_error, only: empm_error_t
   use empm_solver, only: empm_stable_dt
   use empm_loads, only: RAMP_SINE
   implicit none
@@ -156,6 +156,7 @@ contains
     type(empm_basis_t) :: tbasis
     type(empm_step_status_t) :: stat
     real(wp) :: t_end, cfl, dt, its
+    type(empm_error_t) :: err
     integer :: info, ibad, iters, nevals
     if (case_name == 'dyka') then
       call make_dyka(model, gamma)
@@ -165,7 +166,8 @@ contains
       t_end = 2.0_wp; cfl = 0.1_wp
     end if
     call model%finalize_setup()
-    call empm_integrator_create('musl', integ, info)
+    call empm_create_integrator('musl', integ, err)
+    call check_created(err, 'integrator')
     call integ%prepare(model)
     call tmp%alloc(model%grid%ndim, model%pts%np)
     call tbasis%alloc(model%grid%ndim, model%basis%maxn, model%pts%np)
@@ -200,19 +202,23 @@ contains
     real(wp), intent(in) :: gamma
     real(wp), parameter :: L = 0.1333_wp
     real(wp) :: zero3(3)
+    type(empm_error_t) :: err
     integer :: info, nadd, nsel, np
     zero3 = 0.0_wp
     call model%grid%init(1, [0.0_wp], [3.3325e-3_wp], [46], info)
     call model%pts%alloc(1, 40)
     allocate(model%mats(1))
-    call empm_material_create('linear_elastic', 200.0e9_wp, 0.0_wp, 7833.0_wp, &
-                              model%mats(1)%model, info)
+    call empm_create_material('linear_elastic', empm_kv('E', 200.0e9_wp)// &
+                              empm_kv('nu', 0.0_wp)//empm_kv('density', 7833.0_wp), &
+                              model%mats(1)%model, err)
+    call check_created(err, 'Dyka bar material')
     call empm_fill(model%pts, model%grid, GEOM_BOX, zero3, [L, 0.0_wp, 0.0_wp], zero3, &
                    0.0_wp, 1, PLACE_GAUSS, 7833.0_wp, 1, nadd, info)
     np = model%pts%np
     where (model%pts%x(1, 1:np) > 0.75_wp * L) model%pts%v(1, 1:np) = 5.0_wp
     call model%nodes%fix_box(model%grid, zero3, zero3, [.true., .false., .false.], zero3, nsel)
-    call empm_shape_create('lme', 1, model%shape, info, gamma=gamma)
+    call empm_create_shape('lme', model%grid, model%shape, err, empm_kv('gamma', gamma))
+    call check_created(err, 'Dyka bar shape')
   end subroutine make_dyka
 
   !> Andersen block (docs/algorithms.md §3): 10 m × 10 m, h = 2 m, 2×2 Gauss particles per
@@ -221,13 +227,16 @@ contains
     type(empm_model_t), intent(out) :: model
     real(wp), intent(in) :: gamma
     real(wp) :: zero3(3)
+    type(empm_error_t) :: err
     integer :: info, nadd, nsel
     zero3 = 0.0_wp
     call model%grid%init(2, [0.0_wp, 0.0_wp], [2.0_wp, 2.0_wp], [5, 7], info)
     call model%pts%alloc(2, 100)
     allocate(model%mats(1))
-    call empm_material_create('linear_elastic', 5.0e6_wp, 0.0_wp, 6000.0_wp, &
-                              model%mats(1)%model, info)
+    call empm_create_material('linear_elastic', empm_kv('E', 5.0e6_wp)// &
+                              empm_kv('nu', 0.0_wp)//empm_kv('density', 6000.0_wp), &
+                              model%mats(1)%model, err)
+    call check_created(err, 'Andersen block material')
     call empm_fill(model%pts, model%grid, GEOM_BOX, zero3, [10.0_wp, 10.0_wp, 0.0_wp], zero3, &
                    0.0_wp, 2, PLACE_GAUSS, 6000.0_wp, 1, nadd, info)
     call model%nodes%fix_box(model%grid, zero3, [10.0_wp, 0.0_wp, 0.0_wp], &
@@ -239,8 +248,19 @@ contains
     model%loads%gravity = [0.0_wp, -9.81_wp, 0.0_wp]
     model%loads%ramp = RAMP_SINE
     model%loads%t_ramp = 20.0_wp
-    call empm_shape_create('lme', 2, model%shape, info, gamma=gamma)
+    call empm_create_shape('lme', model%grid, model%shape, err, empm_kv('gamma', gamma))
+    call check_created(err, 'Andersen block shape')
   end subroutine make_andersen
+
+  !> Stop when the registry could not create a family (the benchmark cannot run).
+  subroutine check_created(err, what)
+    type(empm_error_t), intent(in) :: err !! status of the creation
+    character(len=*), intent(in) :: what  !! what was created, for the message
+    if (err%code /= 0) then
+      write(output_unit, '(a)') 'lme_bench: '//what//': '//err%message
+      error stop 1
+    end if
+  end subroutine check_created
 
   !> Stop on a failed evaluation (the benchmark is meaningless then).
   subroutine check(info, ibad)
