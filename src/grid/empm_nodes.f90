@@ -20,17 +20,23 @@ module empm_nodes
     real(wp), allocatable :: force(:,:)     !! total force f_I (ndim, nnode) [N]
     real(wp), allocatable :: acc(:,:)       !! acceleration a_I = f_I/m_I (ndim, nnode) [m/s²]
     real(wp), allocatable :: work(:,:)      !! scratch nodal vector (ndim, nnode)
-    logical, allocatable :: fixed(:,:)      !! Dirichlet mask per dof (ndim, nnode)
-    real(wp), allocatable :: vfix(:,:)      !! prescribed velocity on fixed dofs (ndim, nnode) [m/s]
-    integer, allocatable :: fixed_dofs(:)   !! the fixed dofs as positions d + ndim (I − 1) in
-                                            !! the (ndim, nnode) arrays, increasing; derived
-                                            !! from `fixed` by `list_fixed` (fix_box and the
-                                            !! model's set-up call it)
+    ! The constraints are private: `fixed_dofs` must follow `fixed`, so they change only
+    ! through fix_box/fix_dof, and are read through is_fixed/fixed_velocity/nfixed.
+    logical, allocatable, private :: fixed(:,:)     !! Dirichlet mask per dof (ndim, nnode)
+    real(wp), allocatable, private :: vfix(:,:)     !! prescribed velocity (ndim, nnode) [m/s]
+    integer, allocatable, private :: fixed_dofs(:)  !! the fixed dofs as positions
+                                                    !! d + ndim (I − 1), increasing
   contains
     procedure :: alloc => nodes_alloc
     procedure :: reset => nodes_reset
     procedure :: fix_box => nodes_fix_box
-    procedure :: list_fixed => nodes_list_fixed
+    procedure :: fix_dof => nodes_fix_dof
+    procedure :: is_fixed => nodes_is_fixed
+    procedure :: fixed_velocity => nodes_fixed_velocity
+    procedure :: nfixed => nodes_nfixed
+    procedure :: constrain_velocity => nodes_constrain_velocity
+    procedure :: constrain_force => nodes_constrain_force
+    procedure, private :: list_fixed => nodes_list_fixed
   end type empm_nodes_t
 
 contains
@@ -77,7 +83,7 @@ contains
     integer, intent(in) :: n       !! number of entries
     real(wp), intent(out) :: a(n)  !! array
     integer :: i
-    !$omp parallel do schedule(static) if(n >= 65536)
+    !$omp parallel do default(none) shared(a, n) private(i) schedule(static) if(n >= 65536)
     do i = 1, n
       a(i) = 0.0_wp
     end do
@@ -118,8 +124,7 @@ contains
   end subroutine nodes_fix_box
 
   !> Rebuild `fixed_dofs` from `fixed`, so that the constraint passes of every step visit the
-  !> fixed dofs only (none, usually, or a boundary's worth) instead of every node. Call after
-  !> changing `fixed` directly; [[nodes_fix_box]] and the model's set-up call it.
+  !> fixed dofs only (none, usually, or a boundary's worth) instead of every node.
   subroutine nodes_list_fixed(self)
     class(empm_nodes_t), intent(inout) :: self !! nodal fields
     integer :: k
@@ -130,4 +135,84 @@ contains
     allocate(self%fixed_dofs(count(self%fixed)))
     self%fixed_dofs = pack([(k, k = 1, size(self%fixed))], reshape(self%fixed, [size(self%fixed)]))
   end subroutine nodes_list_fixed
+
+  !> Prescribe velocity `value` on component `d` of node `id` (set-up; after fixing many dofs
+  !> one by one, a box is faster: [[nodes_fix_box]]).
+  subroutine nodes_fix_dof(self, d, id, value)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields (allocated)
+    integer, intent(in) :: d                   !! component, 1..ndim
+    integer, intent(in) :: id                  !! node, 1..nnode
+    real(wp), intent(in) :: value              !! prescribed velocity [m/s]
+    self%fixed(d, id) = .true.
+    self%vfix(d, id) = value
+    call self%list_fixed()
+  end subroutine nodes_fix_dof
+
+  !> Whether component `d` of node `id` is prescribed.
+  pure logical function nodes_is_fixed(self, d, id)
+    class(empm_nodes_t), intent(in) :: self !! nodal fields
+    integer, intent(in) :: d                !! component
+    integer, intent(in) :: id               !! node
+    nodes_is_fixed = self%fixed(d, id)
+  end function nodes_is_fixed
+
+  !> Prescribed velocity of component `d` of node `id` (0 when free) [m/s].
+  pure real(wp) function nodes_fixed_velocity(self, d, id)
+    class(empm_nodes_t), intent(in) :: self !! nodal fields
+    integer, intent(in) :: d                !! component
+    integer, intent(in) :: id               !! node
+    nodes_fixed_velocity = merge(self%vfix(d, id), 0.0_wp, self%fixed(d, id))
+  end function nodes_fixed_velocity
+
+  !> Number of prescribed dofs.
+  pure integer function nodes_nfixed(self)
+    class(empm_nodes_t), intent(in) :: self !! nodal fields
+    nodes_nfixed = 0
+    if (allocated(self%fixed_dofs)) nodes_nfixed = size(self%fixed_dofs)
+  end function nodes_nfixed
+
+  !> Impose the Dirichlet conditions on nodal velocities (and the matching momenta): the
+  !> prescribed dofs only (`fixed_dofs`), not every node.
+  subroutine nodes_constrain_velocity(self, v, mom)
+    class(empm_nodes_t), intent(in) :: self           !! nodal constraints and masses
+    real(wp), intent(inout), contiguous :: v(:,:)     !! nodal velocities (ndim, nnode)
+    real(wp), intent(inout), contiguous :: mom(:,:)   !! nodal momenta (ndim, nnode)
+    call constrain_dofs(size(self%fixed_dofs), self%fixed_dofs, self%ndim, self%mass, &
+                        self%vfix, v, mom)
+  end subroutine nodes_constrain_velocity
+
+  !> v = vfix and mom = m vfix on the listed dofs (positions in the (ndim, nnode) arrays).
+  pure subroutine constrain_dofs(n, dofs, nd, mass, vfix, v, mom)
+    integer, intent(in) :: n             !! number of fixed dofs
+    integer, intent(in) :: dofs(n)       !! fixed dofs (positions in the (nd, nnode) arrays)
+    integer, intent(in) :: nd            !! spatial dimension
+    real(wp), intent(in) :: mass(*)      !! nodal masses
+    real(wp), intent(in) :: vfix(*)      !! prescribed velocities (nd, nnode)
+    real(wp), intent(inout) :: v(*)      !! nodal velocities (nd, nnode)
+    real(wp), intent(inout) :: mom(*)    !! nodal momenta (nd, nnode)
+    integer :: k, j
+    do k = 1, n
+      j = dofs(k)
+      v(j) = vfix(j)
+      mom(j) = mass((j - 1) / nd + 1) * vfix(j)
+    end do
+  end subroutine constrain_dofs
+
+  !> Zero nodal forces on the prescribed dofs (zero acceleration there).
+  subroutine nodes_constrain_force(self, f)
+    class(empm_nodes_t), intent(in) :: self           !! nodal constraints
+    real(wp), intent(inout), contiguous :: f(:,:)     !! nodal forces (ndim, nnode)
+    call zero_dofs(size(self%fixed_dofs), self%fixed_dofs, f)
+  end subroutine nodes_constrain_force
+
+  !> f = 0 on the listed dofs.
+  pure subroutine zero_dofs(n, dofs, f)
+    integer, intent(in) :: n             !! number of fixed dofs
+    integer, intent(in) :: dofs(n)       !! fixed dofs (positions in the nodal array)
+    real(wp), intent(inout) :: f(*)      !! nodal forces (ndim, nnode)
+    integer :: k
+    do k = 1, n
+      f(dofs(k)) = 0.0_wp
+    end do
+  end subroutine zero_dofs
 end module empm_nodes

@@ -12,7 +12,7 @@ module empm_integrator
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_SHAPE_FAILED, &
                         STEP_MATERIAL_FAILED
   use empm_transfer, only: p2g_mass, p2g_mass_momentum, p2g_internal_force, p2g_body_force, &
-                           constrain_force, constrain_velocity, nodal_divide_by_mass, g2p_value, &
+                           nodal_divide_by_mass, g2p_value, &
                            velocity_gradient, empm_p2g_work_t
   use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID
   use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds
@@ -166,7 +166,7 @@ contains
       end if
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
-      call constrain_velocity(nodes, nodes%vel, nodes%mom)
+      call nodes%constrain_velocity(nodes%vel, nodes%mom)
       call tm%lap(PHASE_GRID)
     end associate
   end subroutine map_velocity
@@ -190,7 +190,7 @@ contains
                                                 model%pts%x(:, 1:np), self%bwork(:, 1:np))
     call p2g_body_force(model%basis, model%pts%m, g(1:d), self%bwork, use_b, model%nodes%force, &
                         self%p2g)
-    call constrain_force(model%nodes, model%nodes%force)
+    call model%nodes%constrain_force(model%nodes%force)
   end subroutine assemble_forces
 
   !> Strain and stress update of every particle from the nodal velocities `vel`: per block of

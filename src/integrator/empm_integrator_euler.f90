@@ -13,7 +13,7 @@ module empm_integrator_euler
   use empm_integrator, only: empm_integrator_t, map_velocity, update_stress
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: p2g_weighted, g2p_add_scaled, g2p_value, &
-                           nodal_divide_by_mass, constrain_velocity
+                           nodal_divide_by_mass
   use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
@@ -78,7 +78,7 @@ contains
       nodes%mom = nodes%mom + dt * nodes%force
       call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
-      call constrain_velocity(nodes, nodes%vel, nodes%mom)
+      call nodes%constrain_velocity(nodes%vel, nodes%mom)
       call tm%lap(PHASE_GRID)
 
       call g2p_value(basis, nodes%acc, pts%a)
@@ -96,7 +96,7 @@ contains
         call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom, self%p2g)
         call tm%lap(PHASE_P2G)
         call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
-        call constrain_velocity(nodes, nodes%vel, nodes%mom)
+        call nodes%constrain_velocity(nodes%vel, nodes%mom)
         call tm%lap(PHASE_GRID)
         call update_stress(model, nodes%vel, dt, stat)
         call tm%lap(PHASE_STRESS)

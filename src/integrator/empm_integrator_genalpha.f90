@@ -16,8 +16,7 @@ module empm_integrator_genalpha
   use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: p2g_weighted, g2p_add_scaled, g2p_value, &
-                           nodal_divide_by_mass, &
-                           constrain_force
+                           nodal_divide_by_mass
   use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
@@ -106,14 +105,14 @@ contains
       call p2g_weighted(basis, pts%m, pts%a, 0.0_wp, pts%a, nodes%acc, self%p2g)
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%acc, nodes%work)
-      call constrain_force(nodes, nodes%work)
+      call nodes%constrain_force(nodes%work)
       call tm%lap(PHASE_GRID)
       ! a_I^{k+1} in nodes%acc.
       call self%assemble_forces(model, model%t)
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
       nodes%acc = (nodes%acc - am * nodes%work) / (1.0_wp - am)
-      call constrain_force(nodes, nodes%acc)
+      call nodes%constrain_force(nodes%acc)
       call tm%lap(PHASE_GRID)
       ! Particle velocity from both accelerations; then Δu_I (reusing nodes%force).
       call g2p_add_scaled(basis, dt * (1.0_wp - ga), nodes%work, pts%v)

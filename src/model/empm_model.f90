@@ -68,10 +68,12 @@ contains
     np = self%pts%np
     ! Keep constraints set earlier with nodes%fix_box.
     if (.not. allocated(self%nodes%mass) .or. self%nodes%nnode /= self%grid%nnode) &
-      call self%nodes%alloc(self%grid)
-    call self%nodes%list_fixed()
-    call self%basis%alloc(self%grid%ndim, self%shape%max_nodes(self%grid), np, &
-                          self%shape%layout(self%grid))
+      call self%nodes%alloc(self%grid, e)
+    if (e%code == 0) call self%basis%alloc(self%grid%ndim, self%shape%max_nodes(self%grid), np, &
+                                           self%shape%layout(self%grid), e)
+    if (e%code /= 0) then
+      call empm_raise_error(e, err); return
+    end if
     ! Contiguous runs of particles sharing a material: one batched update per run.
     nrun = 0
     do p = 1, np

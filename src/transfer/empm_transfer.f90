@@ -37,7 +37,7 @@ module empm_transfer
   public :: empm_p2g_work_t
   public :: p2g_mass, p2g_weighted, p2g_mass_momentum, p2g_internal_force, p2g_body_force
   public :: g2p_value, g2p_add_scaled, g2p_pc_newmark, velocity_gradient
-  public :: nodal_divide_by_mass, constrain_velocity, constrain_force
+  public :: nodal_divide_by_mass
 
   !> Workspace of a race-free threaded P2G: the mode, the node ranges and the per-thread
   !> nodal accumulators (kept zero between calls).
@@ -671,49 +671,4 @@ contains
     end do
     !$omp end parallel do
   end subroutine divide_2d
-
-  !> Impose Dirichlet conditions on nodal velocity (and the matching momentum) on the fixed
-  !> dofs (`nodes%fixed_dofs`).
-  subroutine constrain_velocity(nodes, v, mom)
-    type(empm_nodes_t), intent(in) :: nodes           !! nodal constraints and masses
-    real(wp), intent(inout), contiguous :: v(:,:)     !! nodal velocities (ndim, nnode)
-    real(wp), intent(inout), contiguous :: mom(:,:)   !! nodal momenta (ndim, nnode)
-    call constrain_dofs(size(nodes%fixed_dofs), nodes%fixed_dofs, nodes%ndim, nodes%mass, &
-                        nodes%vfix, v, mom)
-  end subroutine constrain_velocity
-
-  !> v = vfix and mom = m vfix on the listed dofs (positions in the (ndim, nnode) arrays).
-  pure subroutine constrain_dofs(n, dofs, nd, mass, vfix, v, mom)
-    integer, intent(in) :: n             !! number of fixed dofs
-    integer, intent(in) :: dofs(n)       !! fixed dofs (positions in the (nd, nnode) arrays)
-    integer, intent(in) :: nd            !! spatial dimension
-    real(wp), intent(in) :: mass(*)      !! nodal masses
-    real(wp), intent(in) :: vfix(*)      !! prescribed velocities (nd, nnode)
-    real(wp), intent(inout) :: v(*)      !! nodal velocities (nd, nnode)
-    real(wp), intent(inout) :: mom(*)    !! nodal momenta (nd, nnode)
-    integer :: k, j
-    do k = 1, n
-      j = dofs(k)
-      v(j) = vfix(j)
-      mom(j) = mass((j - 1) / nd + 1) * vfix(j)
-    end do
-  end subroutine constrain_dofs
-
-  !> Zero nodal forces on fixed dofs (zero acceleration there).
-  subroutine constrain_force(nodes, f)
-    type(empm_nodes_t), intent(in) :: nodes           !! nodal constraints
-    real(wp), intent(inout), contiguous :: f(:,:)     !! nodal forces (ndim, nnode)
-    call zero_dofs(size(nodes%fixed_dofs), nodes%fixed_dofs, f)
-  end subroutine constrain_force
-
-  !> f = 0 on the listed dofs.
-  pure subroutine zero_dofs(n, dofs, f)
-    integer, intent(in) :: n             !! number of fixed dofs
-    integer, intent(in) :: dofs(n)       !! fixed dofs (positions in the nodal array)
-    real(wp), intent(inout) :: f(*)      !! nodal forces (ndim, nnode)
-    integer :: k
-    do k = 1, n
-      f(dofs(k)) = 0.0_wp
-    end do
-  end subroutine zero_dofs
 end module empm_transfer
