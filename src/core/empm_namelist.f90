@@ -666,12 +666,12 @@ contains
     type(empm_param_t), intent(in) :: p          !! declaration (kind PARAM_REAL)
     real(wp), intent(inout) :: x                 !! the value (unchanged when absent and optional)
     type(empm_error_t), intent(inout) :: err     !! set when invalid or missing
-    type(text_t), allocatable :: v(:)
+    real(wp) :: a(1)
     integer :: n
-    if (err%code /= 0) return
-    call raw(self, p, v, n, err)
-    if (err%code /= 0 .or. n == 0) return
-    call to_real(self, p, v(1)%s, x, err)
+    ! One value: the array getter with room for one (the declaration's count is 1).
+    a(1) = x
+    call self%get_reals(p, a, n, err)
+    if (err%code == 0 .and. n > 0) x = a(1)
   end subroutine get_real
 
   subroutine get_reals(self, p, x, n, err)
@@ -713,12 +713,12 @@ contains
     type(empm_param_t), intent(in) :: p          !! declaration (kind PARAM_INT)
     integer, intent(inout) :: x                  !! the value (unchanged when absent and optional)
     type(empm_error_t), intent(inout) :: err     !! set when invalid or missing
-    type(text_t), allocatable :: v(:)
+    integer :: a(1)
     integer :: n
-    if (err%code /= 0) return
-    call raw(self, p, v, n, err)
-    if (err%code /= 0 .or. n == 0) return
-    call to_int(self, p, v(1)%s, x, err)
+    ! One value: the array getter with room for one (the declaration's count is 1).
+    a(1) = x
+    call self%get_ints(p, a, n, err)
+    if (err%code == 0 .and. n > 0) x = a(1)
   end subroutine get_int
 
   subroutine get_ints(self, p, x, n, err)
@@ -818,12 +818,12 @@ contains
     type(empm_param_t), intent(in) :: p          !! declaration (kind PARAM_LOGICAL)
     logical, intent(inout) :: x                  !! the value (unchanged when absent and optional)
     type(empm_error_t), intent(inout) :: err     !! set when invalid or missing
-    type(text_t), allocatable :: v(:)
+    logical :: a(1)
     integer :: n
-    if (err%code /= 0) return
-    call raw(self, p, v, n, err)
-    if (err%code /= 0 .or. n == 0) return
-    call to_logical(self, p, v(1)%s, x, err)
+    ! One value: the array getter with room for one (the declaration's count is 1).
+    a(1) = x
+    call self%get_logicals(p, a, n, err)
+    if (err%code == 0 .and. n > 0) x = a(1)
   end subroutine get_logical
 
   subroutine get_logicals(self, p, x, n, err)
