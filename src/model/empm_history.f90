@@ -2,7 +2,9 @@
 !> Filled by the solver, written to HDF5 by the output layer, or read directly by an
 !> embedding code.
 module empm_history
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t, empm_raise_error, empm_alloc_error
   use empm_particles, only: empm_particles_t
   implicit none
   private
@@ -47,15 +49,18 @@ module empm_history
 contains
 
   !> Prepare an empty record for `nprobe` probes following the given particles, with room for
-  !> `capacity` samples and `nsnap_max` snapshots.
-  subroutine history_init(self, ndim, names, particles, capacity, nsnap_max)
+  !> `capacity` samples and `nsnap_max` snapshots. An allocation failure is reported in `err`
+  !> when present (with the memory asked for), otherwise it stops the program.
+  subroutine history_init(self, ndim, names, particles, capacity, nsnap_max, err)
     class(empm_history_t), intent(inout) :: self    !! record
     integer, intent(in) :: ndim                     !! spatial dimension
     character(len=*), intent(in) :: names(:)        !! probe names
     integer, intent(in) :: particles(:)             !! particle index of each probe
     integer, intent(in) :: capacity                 !! initial number of samples reserved
     integer, intent(in) :: nsnap_max                !! number of snapshots reserved
-    integer :: n, c
+    type(empm_error_t), intent(inout), optional :: err !! set on an allocation failure
+    integer :: n, c, stat
+    character(len=256) :: msg
     n = size(particles); c = max(capacity, 16)
     self%nt = 0; self%nprobe = n; self%nsnap = 0
     if (allocated(self%t)) deallocate(self%t, self%kinetic, self%strain, self%gravity, &
@@ -64,7 +69,10 @@ contains
     allocate(self%probe_name(n), self%probe_particle(n))
     self%probe_name = names; self%probe_particle = particles
     allocate(self%t(c), self%kinetic(c), self%strain(c), self%gravity(c), &
-      self%px(ndim, n, c), self%pv(ndim, n, c), self%ps(6, n, c), self%snap(max(nsnap_max, 1)))
+      self%px(ndim, n, c), self%pv(ndim, n, c), self%ps(6, n, c), self%snap(max(nsnap_max, 1)), &
+      stat=stat, errmsg=msg)
+    if (stat /= 0) call empm_raise_error(empm_alloc_error('history buffers', &
+      8_int64 * c * (4 + n * (2 * ndim + 6)), msg), err)
   end subroutine history_init
 
   !> Append one sample. Storage grows geometrically when full (rare, amortised).
