@@ -3,18 +3,21 @@ program empm_main
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use empm, only: empm_version, empm_run_case, empm_error_t
   use empm_terminal, only: empm_exit
+  use empm_parallel, only: empm_set_threads
+  use empm_solver, only: empm_run_stats_t, empm_run_summary
   use empm_files, only: empm_mkdir_p
   use empm_verify_suite, only: empm_verify_run
   use empm_input, only: empm_input_markdown
   use empm_bench, only: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json
   implicit none
-  integer :: nargs, i, ios, nfail, npat
+  integer :: nargs, i, ios, nfail, npat, nthreads
   character(len=:), allocatable :: cmd, case_file, out_file, written, manifest, outdir
   character(len=256), allocatable :: patterns(:)
   logical :: quick
   type(empm_error_t) :: err
   type(empm_bench_config_t) :: bcfg
   type(empm_bench_result_t) :: bres
+  type(empm_run_stats_t) :: stats
 
   nargs = command_argument_count()
   if (nargs == 0) then
@@ -27,13 +30,19 @@ program empm_main
   case ('-V', '--version', 'version')
     write(output_unit, '(a)') 'empm '//empm_version()
   case ('run')
-    case_file = ''; out_file = ''
+    case_file = ''; out_file = ''; nthreads = 0
     i = 2
     do while (i <= nargs)
       select case (arg(i))
+      case ('-h', '--help')
+        call usage_run(output_unit); call empm_exit(0)
       case ('-o', '--output')
         if (i == nargs) call die('option '//arg(i)//' needs a file name')
         out_file = arg(i + 1); i = i + 2
+      case ('-t', '--threads')
+        if (i == nargs) call die('option '//arg(i)//' needs a value')
+        nthreads = int_arg(i); i = i + 2
+        if (nthreads < 1) call die('option --threads needs a positive integer')
       case default
         if (index(arg(i), '-') == 1) call die('unknown option '//arg(i))
         if (len(case_file) > 0) call die('only one case file per run (got '//case_file// &
@@ -42,8 +51,12 @@ program empm_main
       end select
     end do
     if (len(case_file) == 0) call die('empm run needs a case file: empm run CASE.nml')
+    if (nthreads > 0) call empm_set_threads(nthreads)
     ! A verification case file also runs: its &verify group is the suite's, not the run's.
-    call empm_run_case(case_file, out_file, written=written, err=err, extra_groups='verify')
+    call empm_run_case(case_file, out_file, written=written, err=err, extra_groups='verify', &
+                       stats=stats)
+    ! The summary also for a run stopped by a guard (whenever the time loop ran).
+    if (stats%ran) write(output_unit, '(a)', iostat=ios) 'empm: '//empm_run_summary(stats)
     if (err%code /= 0) then
       write(error_unit, '(a)') 'empm: error: '//err%message
       call empm_exit(err%code)
@@ -55,6 +68,8 @@ program empm_main
     i = 2
     do while (i <= nargs)
       select case (arg(i))
+      case ('-h', '--help')
+        call usage_verify(output_unit); call empm_exit(0)
       case ('--quick')
         quick = .true.; i = i + 1
       case ('--out', '-o')
@@ -81,6 +96,9 @@ program empm_main
   case ('bench')
     i = 2
     do while (i <= nargs)
+      if (arg(i) == '-h' .or. arg(i) == '--help') then
+        call usage_bench(output_unit); call empm_exit(0)
+      end if
       if (i == nargs) call die('option '//arg(i)//' needs a value')
       select case (arg(i))
       case ('--dim');        bcfg%dim = int_arg(i)
@@ -102,6 +120,11 @@ program empm_main
     end if
     write(output_unit, '(a)') empm_bench_json(bres)
   case ('keys')
+    if (nargs == 2) then
+      if (arg(2) == '-h' .or. arg(2) == '--help') then
+        call usage_keys(output_unit); call empm_exit(0)
+      end if
+    end if
     if (nargs > 1) call die('empm keys takes no argument')
     write(output_unit, '(a)', advance='no') empm_input_markdown()
   case default
@@ -135,14 +158,71 @@ contains
     call empm_exit(1)
   end subroutine die
 
+  subroutine usage_run(u)
+    integer, intent(in) :: u
+    write(u, '(a)') 'usage: empm run CASE.nml [-o OUT.h5] [--threads N]'
+    write(u, '(a)') ''
+    write(u, '(a)') 'Runs the case file CASE.nml (keys: empm keys, docs/input.md) and writes OUT.h5'
+    write(u, '(a)') 'and OUT.xmf for ParaView (docs/output.md, docs/paraview.md). The first'
+    write(u, '(a)') 'snapshot is the state at t = 0.'
+    write(u, '(a)') ''
+    write(u, '(a)') '  -o, --output OUT.h5  output file (default: the &output file, else CASE.h5)'
+    write(u, '(a)') '  -t, --threads N      OpenMP threads (default: OMP_NUM_THREADS or all cores)'
+    write(u, '(a)') '  -h, --help           this text'
+    write(u, '(a)') ''
+    write(u, '(a)') 'Progress goes to stderr: one updated line on a terminal, a plain line every'
+    write(u, '(a)') '10 % of t_end or 10 s otherwise. At the end one summary line (steps, dt range,'
+    write(u, '(a)') 'wall time, total energy at the start and end and its relative drift) and'
+    write(u, '(a)') '"wrote OUT.h5" go to stdout.'
+    write(u, '(a)') ''
+    write(u, '(a)') 'exit status: 0 success, 1 usage error, 2 invalid case file,'
+    write(u, '(a)') '             3 run stopped by a guard (results marked incomplete), 4 I/O error'
+  end subroutine usage_run
+
+  subroutine usage_verify(u)
+    integer, intent(in) :: u
+    write(u, '(a)') 'usage: empm verify [PATTERN...] [--quick] [--out DIR] [--manifest FILE]'
+    write(u, '(a)') ''
+    write(u, '(a)') 'Runs the verification studies listed in verification/cases.txt (or FILE), only'
+    write(u, '(a)') 'the runs whose id or group matches a PATTERN (* wildcard, e.g. ''dyka/*''),'
+    write(u, '(a)') 'writes DIR/raw/*.h5 and DIR/summary.json (default DIR: reports) and exits'
+    write(u, '(a)') 'with status 5 when a check fails (docs/verification.md).'
+    write(u, '(a)') ''
+    write(u, '(a)') '  --quick          coarse levels only'
+    write(u, '(a)') '  -o, --out DIR    output folder (default: reports)'
+    write(u, '(a)') '  --manifest FILE  list of studies (default: verification/cases.txt)'
+    write(u, '(a)') '  -h, --help       this text'
+  end subroutine usage_verify
+
+  subroutine usage_bench(u)
+    integer, intent(in) :: u
+    write(u, '(a)') 'usage: empm bench [--dim 2|3] [--shape S] [--cells N] [--ppc P] [--steps K]'
+    write(u, '(a)') '                  [--threads T] [--integrator I] [--warmup W]'
+    write(u, '(a)') ''
+    write(u, '(a)') 'Times a freely vibrating elastic block (N^dim cells, P particles per cell) and'
+    write(u, '(a)') 'prints one JSON object (docs/performance.md). S is a shape identifier as in a'
+    write(u, '(a)') 'case file: linear, ugimp, bspline2, bspline3, lme, lme_g<gamma>; I an'
+    write(u, '(a)') 'integrator (usf, usl, musl, pc_published, pc_newmark, gen_alpha); K timed'
+    write(u, '(a)') 'steps after W warm-up steps on T threads.'
+  end subroutine usage_bench
+
+  subroutine usage_keys(u)
+    integer, intent(in) :: u
+    write(u, '(a)') 'usage: empm keys'
+    write(u, '(a)') ''
+    write(u, '(a)') 'Prints, as Markdown, every key of the case files with the parameters each'
+    write(u, '(a)') 'shape family, material model and integrator declares (docs/input.md).'
+  end subroutine usage_keys
+
   subroutine usage(u)
     integer, intent(in) :: u
-    write(u, '(a)') 'usage: empm run CASE.nml [-o OUT.h5]'
+    write(u, '(a)') 'usage: empm run CASE.nml [-o OUT.h5] [--threads N]'
     write(u, '(a)') '       empm verify [PATTERN...] [--quick] [--out DIR] [--manifest FILE]'
     write(u, '(a)') '       empm keys'
     write(u, '(a)') '       empm bench [--dim 2|3] [--shape S] [--cells N] [--ppc P] [--steps K]'
     write(u, '(a)') '                  [--threads T] [--integrator I] [--warmup W]'
     write(u, '(a)') '       empm --help | --version'
+    write(u, '(a)') '       empm COMMAND --help'
     write(u, '(a)') ''
     write(u, '(a)') 'Runs an explicit MPM simulation described by a namelist case file'
     write(u, '(a)') '(keys: docs/input.md) and writes HDF5 results plus an XDMF file for'

@@ -5,7 +5,7 @@ module empm_driver
   use empm_case, only: empm_case_t
   use empm_input, only: empm_read_case
   use empm_history, only: empm_history_t
-  use empm_solver, only: empm_solve
+  use empm_solver, only: empm_solve, empm_run_stats_t
   use empm_output, only: empm_write_results, empm_output_meta_t
   implicit none
   private
@@ -16,19 +16,28 @@ contains
   !> Run the case in `path`, writing HDF5 to `output` (default: the case's &output file).
   !> Exit-status semantics when `err` is absent: 2 invalid input, 3 run-time guard, 4 I/O.
   !> A run stopped by a guard still writes its last good state, marked incomplete.
-  subroutine empm_run_case(path, output, progress, written, err, extra_groups)
+  !> The state at the start is stored as the first snapshot (t = 0, `/snapshots/000000`) even
+  !> when the case's `snapshot_times` do not include it, unless `initial_snapshot` is false.
+  subroutine empm_run_case(path, output, progress, written, err, extra_groups, stats, &
+                           initial_snapshot)
     character(len=*), intent(in) :: path                !! case file
     character(len=*), intent(in), optional :: output    !! output HDF5 path override
-    logical, intent(in), optional :: progress           !! progress line on a terminal (default on)
+    logical, intent(in), optional :: progress           !! progress on stderr (default on; false
+                                                        !! keeps the library quiet)
     character(len=:), allocatable, intent(out), optional :: written !! path of the HDF5 file
     type(empm_error_t), intent(out), optional :: err    !! error, if present
     character(len=*), intent(in), optional :: extra_groups !! groups of the case file that are
                                                         !! not the run's (blank-separated, e.g.
                                                         !! 'verify'): skipped, not rejected
+    type(empm_run_stats_t), intent(out), optional :: stats !! steps, time steps, wall time and
+                                                        !! energy balance (for a summary line)
+    logical, intent(in), optional :: initial_snapshot   !! store the start as a snapshot
+                                                        !! (default true)
     type(empm_case_t) :: cs
     type(empm_history_t) :: hist
     type(empm_error_t) :: e, ew
     type(empm_output_meta_t) :: meta
+    logical :: add0
 
     call empm_read_case(path, cs, e, extra_groups=extra_groups)
     if (e%code /= EMPM_OK) then
@@ -38,9 +47,15 @@ contains
       if (len_trim(output) > 0) cs%output_file = trim(output)
     end if
     if (present(progress)) cs%run%progress = progress
+    ! A first frame at the start time, so that viewers show the undeformed state. The solver
+    ! stores it before the first step: the time steps are unchanged.
+    add0 = .true.
+    if (present(initial_snapshot)) add0 = initial_snapshot
+    if (size(cs%run%snapshot_times) > 0) add0 = add0 .and. cs%run%snapshot_times(1) > cs%model%t
+    if (add0) cs%run%snapshot_times = [cs%model%t, cs%run%snapshot_times]
     call hist%init(cs%model%grid%ndim, cs%probe_name, cs%probe_particle, 1024, &
                    size(cs%run%snapshot_times))
-    call empm_solve(cs%model, cs%integ, cs%run, hist, e)
+    call empm_solve(cs%model, cs%integ, cs%run, hist, e, stats)
 
     meta%case_file = path; meta%case_text = cs%text
     meta%shape = cs%shape_name; meta%integrator = cs%scheme_name

@@ -6,6 +6,14 @@
 !>
 !> The materials' state variables are written by name (`state/<name>`, one value per particle),
 !> NaN for the particles whose material does not declare that name.
+!>
+!> The XDMF file (same folder, `.xmf`) is written atomically too and refers to the HDF5 file by
+!> its bare name, so it opens from any working directory. Its fields come from the `xdmf`
+!> subgroup of each frame, in the layouts XDMF readers agree on: vectors padded to 3 components
+!> and symmetric tensors as full 3x3 tensors (9 components, row by row). Not `Tensor6`: VTK's
+!> XDMF 2 reader expands Tensor6 in XDMF order (xx, xy, xz, yy, yz, zz) but its Xdmf3 readers
+!> pass the 6 values through and ParaView labels them in VTK's order (XX, YY, ZZ, XY, YZ, XZ),
+!> so no 6-value order reads right in both (docs/paraview.md).
 module empm_output
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
   use hdf5, only: h5open_f, h5fcreate_f, h5fclose_f, H5F_ACC_TRUNC_F
@@ -20,7 +28,7 @@ module empm_output
   use empm_particles, only: empm_particles_t
   implicit none
   private
-  public :: empm_write_results, empm_output_meta_t
+  public :: empm_write_results, empm_output_meta_t, empm_xdmf_path
 
   !> Descriptive metadata stored as root attributes.
   type :: empm_output_meta_t
@@ -45,7 +53,7 @@ contains
     type(empm_error_t), intent(out), optional :: err   !! error, if present
     integer(hid_t) :: fid, g, gs, gp
     integer :: ierr, e, k, info, n
-    character(len=:), allocatable :: tmp
+    character(len=:), allocatable :: tmp, xmf
     character(len=16) :: sname
     character(len=STATE_NAME_LEN), allocatable :: snames(:)
     integer, allocatable :: scol(:,:)
@@ -82,6 +90,15 @@ contains
     call h5_attr(g, 'step', model%step, ierr)
     call write_state(g, model%pts, ierr)
     call write_state_vars(g, model%pts%state, model%pts%mat, snames, scol, ierr)
+    call write_xdmf_fields(g, model%pts%x(:, 1:model%pts%np), model%pts%x0(:, 1:model%pts%np), &
+      model%pts%v(:, 1:model%pts%np), model%pts%stress(:, 1:model%pts%np), &
+      model%pts%strain(:, 1:model%pts%np), ierr)
+    call h5_close_group(g, ierr)
+
+    ! Polyvertex connectivity (0-based), shared by every frame: without it ParaView's XDMF
+    ! reader builds no cells and its default view is empty.
+    call h5_group(fid, 'xdmf', g, ierr)
+    call h5_write(g, 'vertices', [(k - 1, k = 1, model%pts%np)], ierr)
     call h5_close_group(g, ierr)
 
     call h5_group(fid, 'snapshots', gs, ierr)
@@ -102,6 +119,8 @@ contains
       n = min(size(hist%snap(k)%m), model%pts%np)
       if (allocated(hist%snap(k)%state)) call write_state_vars(g, hist%snap(k)%state(:, 1:n), &
         model%pts%mat(1:n), snames, scol, ierr)
+      call write_xdmf_fields(g, hist%snap(k)%x(:, 1:n), model%pts%x0(:, 1:n), &
+        hist%snap(k)%v(:, 1:n), hist%snap(k)%stress(:, 1:n), hist%snap(k)%strain(:, 1:n), ierr)
       call h5_close_group(g, ierr)
     end do
     call h5_close_group(gs, ierr)
@@ -131,13 +150,19 @@ contains
       info = empm_remove(tmp)
       call empm_raise(EMPM_ERR_IO, path//': writing the HDF5 output failed', err); return
     end if
-    call write_xdmf(path, model, hist, snames, ierr)
+    xmf = empm_xdmf_path(path)
+    call write_xdmf(xmf//'.partial', basename(path), model, hist, snames, ierr)
     if (ierr /= 0) then
-      info = empm_remove(tmp)
-      call empm_raise(EMPM_ERR_IO, path//': cannot write the XDMF file', err); return
+      info = empm_remove(tmp); info = empm_remove(xmf//'.partial')
+      call empm_raise(EMPM_ERR_IO, path//': cannot write the XDMF file '//xmf//'.partial', err)
+      return
     end if
     if (empm_rename(tmp, path) /= 0) then
-      call empm_raise(EMPM_ERR_IO, path//': cannot rename '//tmp//' to '//path, err)
+      info = empm_remove(xmf//'.partial')
+      call empm_raise(EMPM_ERR_IO, path//': cannot rename '//tmp//' to '//path, err); return
+    end if
+    if (empm_rename(xmf//'.partial', xmf) /= 0) then
+      call empm_raise(EMPM_ERR_IO, path//': cannot rename '//xmf//'.partial to '//xmf, err)
     end if
   end subroutine empm_write_results
 
@@ -231,42 +256,85 @@ contains
     y(1:size(x, 1), :) = x
   end function pad3
 
-  !> XDMF 2 temporal collection of the snapshots and the final state (particles as vertices),
-  !> with one scalar attribute per state variable.
-  subroutine write_xdmf(path, model, hist, snames, ierr)
+  !> The XDMF file written beside `path`: `path` without a final `.h5`/`.hdf5`, plus `.xmf`.
+  pure function empm_xdmf_path(path) result(xmf)
+    character(len=*), intent(in) :: path !! HDF5 output path
+    character(len=:), allocatable :: xmf !! XDMF path, same folder
+    integer :: n
+    n = len_trim(path)
+    if (ends_with(path(1:n), '.h5')) then
+      xmf = path(1:n - 3)//'.xmf'
+    else if (ends_with(path(1:n), '.hdf5')) then
+      xmf = path(1:n - 5)//'.xmf'
+    else
+      xmf = path(1:n)//'.xmf'
+    end if
+  contains
+    pure logical function ends_with(s, suffix)
+      character(len=*), intent(in) :: s, suffix
+      ends_with = .false.
+      if (len(s) > len(suffix)) ends_with = s(len(s) - len(suffix) + 1:) == suffix
+    end function ends_with
+  end function empm_xdmf_path
+
+  ! The file name of `path` without its folder: the XDMF refers to the HDF5 file beside it
+  ! this way, which readers resolve against the XDMF's own folder.
+  pure function basename(path) result(b)
     character(len=*), intent(in) :: path
+    character(len=:), allocatable :: b
+    b = path(index(path, '/', back=.true.) + 1:len_trim(path))
+  end function basename
+
+  ! Subgroup `xdmf` of a frame group: displacement x − x0 and velocity padded to 3 components,
+  ! stress and strain as full tensors (xx, xy, xz, yx, yy, yz, zx, zy, zz).
+  subroutine write_xdmf_fields(g, x, x0, v, stress, strain, ierr)
+    integer(hid_t), intent(in) :: g
+    real(wp), intent(in) :: x(:,:), x0(:,:), v(:,:), stress(:,:), strain(:,:)
+    integer, intent(inout) :: ierr
+    integer, parameter :: FULL(9) = [1, 6, 5, 6, 2, 4, 5, 4, 3] ! Voigt row of each entry
+    integer(hid_t) :: gx
+    call h5_group(g, 'xdmf', gx, ierr)
+    call h5_write(gx, 'displacement', pad3(x - x0), ierr)
+    call h5_write(gx, 'velocity', pad3(v), ierr)
+    call h5_write(gx, 'stress', stress(FULL, :), ierr)
+    call h5_write(gx, 'strain', strain(FULL, :), ierr)
+    call h5_close_group(gx, ierr)
+  end subroutine write_xdmf_fields
+
+  !> XDMF 2 temporal collection, one polyvertex grid per snapshot and the final state (unless
+  !> the last snapshot is it), written to `xmf` (the caller renames it) with every write
+  !> checked; `ierr` /= 0 on failure. `h5name` is the HDF5 file relative to the XDMF's folder.
+  subroutine write_xdmf(xmf, h5name, model, hist, snames, ierr)
+    character(len=*), intent(in) :: xmf
+    character(len=*), intent(in) :: h5name
     type(empm_model_t), intent(in) :: model
     type(empm_history_t), intent(in) :: hist
     character(len=*), intent(in) :: snames(:)
     integer, intent(inout) :: ierr
-    integer :: u, k, ios, s
-    character(len=:), allocatable :: xmf, h5name
+    character(len=*), parameter :: NL = new_line('a')
+    character(len=:), allocatable :: doc
+    integer :: u, k, ios
     character(len=16) :: sname
-    s = index(path, '/', back=.true.)
-    h5name = path(s + 1:)
-    k = index(path, '.h5', back=.true.)
-    if (k > 0) then
-      xmf = path(1:k - 1)//'.xmf'
-    else
-      xmf = path//'.xmf'
-    end if
+    logical :: final_frame
+    doc = '<?xml version="1.0" ?>'//NL//'<Xdmf Version="2.0">'//NL//' <Domain>'//NL// &
+      '  <Grid Name="particles" GridType="Collection" CollectionType="Temporal">'//NL
+    do k = 1, hist%nsnap
+      write(sname, '(i6.6)') k - 1
+      call grid_entry(hist%snap(k)%t, min(size(hist%snap(k)%m), model%pts%np), &
+        '/snapshots/'//trim(sname))
+    end do
+    final_frame = hist%nsnap == 0
+    if (.not. final_frame) final_frame = hist%snap(hist%nsnap)%step /= model%step
+    if (final_frame) call grid_entry(model%t, model%pts%np, '/final')
+    doc = doc//'  </Grid>'//NL//' </Domain>'//NL//'</Xdmf>'
     open(newunit=u, file=xmf, status='replace', action='write', iostat=ios)
     if (ios /= 0) then
       ierr = 1; return
     end if
-    write(u, '(a)') '<?xml version="1.0" ?>'
-    write(u, '(a)') '<Xdmf Version="2.0">'
-    write(u, '(a)') ' <Domain>'
-    write(u, '(a)') '  <Grid Name="particles" GridType="Collection" CollectionType="Temporal">'
-    do k = 1, hist%nsnap
-      write(sname, '(i6.6)') k - 1
-      call grid_entry(hist%snap(k)%t, size(hist%snap(k)%m), '/snapshots/'//trim(sname))
-    end do
-    if (hist%nsnap == 0) call grid_entry(model%t, model%pts%np, '/final')
-    write(u, '(a)') '  </Grid>'
-    write(u, '(a)') ' </Domain>'
-    write(u, '(a)') '</Xdmf>'
-    close(u)
+    write(u, '(a)', iostat=ios) doc
+    if (ios /= 0) ierr = 1
+    close(u, iostat=ios)
+    if (ios /= 0) ierr = 1
   contains
     subroutine grid_entry(t, np, grp)
       real(wp), intent(in) :: t
@@ -276,37 +344,60 @@ contains
       integer :: j
       write(cnp, '(i0)') np
       write(ct, '(es24.16)') t
-      write(u, '(a)') '   <Grid Name="t" GridType="Uniform">'
-      write(u, '(a)') '    <Time Value="'//trim(adjustl(ct))//'"/>'
-      write(u, '(a)') '    <Topology TopologyType="Polyvertex" NumberOfElements="'// &
-        trim(cnp)//'"/>'
-      write(u, '(a)') '    <Geometry GeometryType="XYZ">'
-      call item(grp//'/xyz', trim(cnp)//' 3')
-      write(u, '(a)') '    </Geometry>'
-      call attribute('velocity', 'Vector', grp//'/v', trim(cnp)//' '//dimstr(model%grid%ndim))
-      call attribute('stress', 'Tensor6', grp//'/stress', trim(cnp)//' 6')
+      doc = doc//'   <Grid Name="t" GridType="Uniform">'//NL// &
+        '    <Time Value="'//trim(adjustl(ct))//'"/>'//NL// &
+        '    <Topology TopologyType="Polyvertex" NumberOfElements="'//trim(cnp)// &
+        '" NodesPerElement="1">'//NL
+      call item('/xdmf/vertices', trim(cnp)//' 1', 'Int', '4')
+      doc = doc//'    </Topology>'//NL//'    <Geometry GeometryType="XYZ">'//NL
+      call item(grp//'/xyz', trim(cnp)//' 3', 'Float', '8')
+      doc = doc//'    </Geometry>'//NL
+      call attribute('displacement', 'Vector', grp//'/xdmf/displacement', trim(cnp)//' 3')
+      call attribute('velocity', 'Vector', grp//'/xdmf/velocity', trim(cnp)//' 3')
+      call attribute('stress', 'Tensor', grp//'/xdmf/stress', trim(cnp)//' 9')
+      call attribute('strain', 'Tensor', grp//'/xdmf/strain', trim(cnp)//' 9')
       call attribute('density', 'Scalar', grp//'/density', trim(cnp))
+      call attribute('volume', 'Scalar', grp//'/volume', trim(cnp))
+      ! Particles keep their material: every frame shows the final indices.
+      call attribute('material', 'Scalar', '/final/material', trim(cnp), 'Int', '4')
       do j = 1, size(snames)
         call attribute(trim(snames(j)), 'Scalar', grp//'/state/'//trim(snames(j)), trim(cnp))
       end do
-      write(u, '(a)') '   </Grid>'
+      doc = doc//'   </Grid>'//NL
     end subroutine grid_entry
-    subroutine attribute(name, kind, ds, dims)
+    subroutine attribute(name, kind, ds, dims, ntype, prec)
       character(len=*), intent(in) :: name, kind, ds, dims
-      write(u, '(a)') '    <Attribute Name="'//name//'" AttributeType="'//kind// &
-        '" Center="Node">'
-      call item(ds, dims)
-      write(u, '(a)') '    </Attribute>'
+      character(len=*), intent(in), optional :: ntype, prec
+      doc = doc//'    <Attribute Name="'//name//'" AttributeType="'//kind// &
+        '" Center="Node">'//NL
+      if (present(ntype)) then
+        call item(ds, dims, ntype, prec)
+      else
+        call item(ds, dims, 'Float', '8')
+      end if
+      doc = doc//'    </Attribute>'//NL
     end subroutine attribute
-    subroutine item(ds, dims)
-      character(len=*), intent(in) :: ds, dims
-      write(u, '(a)') '     <DataItem Dimensions="'//dims//'" NumberType="Float" '// &
-        'Precision="8" Format="HDF">'//h5name//':'//ds//'</DataItem>'
+    subroutine item(ds, dims, ntype, prec)
+      character(len=*), intent(in) :: ds, dims, ntype, prec
+      ! The file name comes from the user (-o): escaped as XML text.
+      doc = doc//'     <DataItem Dimensions="'//dims//'" NumberType="'//ntype//'" '// &
+        'Precision="'//prec//'" Format="HDF">'//xml_text(h5name)//':'//ds//'</DataItem>'//NL
     end subroutine item
-    pure function dimstr(d) result(c)
-      integer, intent(in) :: d
-      character(len=1) :: c
-      c = achar(iachar('0') + d)
-    end function dimstr
   end subroutine write_xdmf
+
+  ! `s` with the XML special characters escaped.
+  pure function xml_text(s) result(r)
+    character(len=*), intent(in) :: s
+    character(len=:), allocatable :: r
+    integer :: i
+    r = ''
+    do i = 1, len(s)
+      select case (s(i:i))
+      case ('&'); r = r//'&amp;'
+      case ('<'); r = r//'&lt;'
+      case ('>'); r = r//'&gt;'
+      case default; r = r//s(i:i)
+      end select
+    end do
+  end function xml_text
 end module empm_output

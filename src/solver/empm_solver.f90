@@ -17,6 +17,7 @@ module empm_solver
   private
   public :: empm_run_params
   public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies, empm_check_guards
+  public :: empm_run_stats_t, empm_run_summary
 
   !> How to run: end time, time step control, output sampling.
   type :: empm_run_config_t
@@ -26,8 +27,27 @@ module empm_solver
     integer :: max_steps = huge(1)             !! safety cap on the number of steps
     integer :: history_every = 1               !! record energies and probes every n steps
     real(wp), allocatable :: snapshot_times(:) !! times at which to store snapshots [s]
-    logical :: progress = .true.               !! progress line on stderr (terminals only)
+    logical :: progress = .true.               !! progress on stderr: a line updated in place
+                                               !! on a terminal, plain lines (every 10 % of
+                                               !! t_end or 10 s) otherwise
   end type empm_run_config_t
+
+  !> What a run did, for an end-of-run summary ([[empm_run_summary]]).
+  type :: empm_run_stats_t
+    logical :: ran = .false.            !! the time loop was entered (false when the run was
+                                        !! refused before it, e.g. t_end not after the start)
+    integer :: steps = 0                !! steps taken by this call
+    real(wp) :: dt_min = 0.0_wp         !! smallest time step [s] (0 when no step was taken)
+    real(wp) :: dt_max = 0.0_wp         !! largest time step [s]
+    real(wp) :: wall = 0.0_wp           !! wall-clock time of the time loop [s]
+    real(wp) :: t_start = 0.0_wp        !! time at the start [s]
+    real(wp) :: t_reached = 0.0_wp      !! time reached [s]
+    real(wp) :: energy_initial = 0.0_wp !! total energy (kinetic + strain + gravity) at the start [J]
+    real(wp) :: energy_final = 0.0_wp   !! total energy at the end (last good state) [J]
+    real(wp) :: work_gravity = 0.0_wp   !! work of a time-varying gravity, −∫ Σ m ġ·x dt [J]
+                                        !! (trapezoidal per step): what the total energy
+                                        !! gains from a gravity ramp
+  end type empm_run_stats_t
 
 contains
 
@@ -88,19 +108,24 @@ contains
   !> Run `model` with `integ` until `cfg%t_end`. Records energies, probes and snapshots in
   !> `hist`. On a tripped guard the model is restored to the last good state and the error
   !> (code EMPM_ERR_RUNTIME) names the step, the particle or node and the quantity.
-  subroutine empm_solve(model, integ, cfg, hist, err)
+  subroutine empm_solve(model, integ, cfg, hist, err, stats)
     type(empm_model_t), intent(inout) :: model                !! simulation (set up)
     class(empm_integrator_t), intent(inout) :: integ          !! time integrator
     type(empm_run_config_t), intent(in) :: cfg                !! run controls
     type(empm_history_t), intent(inout) :: hist               !! record (initialised by caller)
     type(empm_error_t), intent(out), optional :: err          !! error, if present
+    type(empm_run_stats_t), intent(out), optional :: stats    !! steps, time steps, wall time and
+                                                              !! energies of the run (also when
+                                                              !! a guard stopped it)
     type(empm_particles_t) :: good
     type(empm_step_status_t) :: stat
     real(wp), allocatable :: psi(:)
     real(wp) :: dt, dt_stable, ekin, estr, egrav, t_good, t_next_snap
     integer :: isnap, nsnap, step_good
     integer(int64) :: clock0, clock_last, clock, rate
-    logical :: show
+    logical :: show, tty
+    type(empm_run_stats_t) :: st
+    real(wp) :: t_report
     character(len=:), allocatable :: msg
     type(empm_error_t) :: e
     integer :: astat
@@ -127,9 +152,14 @@ contains
     isnap = 1
     call empm_energies(model, psi, ekin, estr, egrav)
     call hist%add_sample(model%t, ekin, estr, egrav, model%pts)
+    st%t_start = model%t; st%energy_initial = ekin + estr + egrav
+    st%dt_min = huge(1.0_wp)
     call skip_past_snapshots()
-    show = .false.
-    if (cfg%progress) show = stderr_is_terminal()
+    show = cfg%progress
+    tty = .false.
+    if (show) tty = stderr_is_terminal()
+    ! Plain lines (logs, pipes) are written when t passes the next tenth of the run.
+    t_report = model%t + 0.1_wp * (cfg%t_end - model%t)
     call system_clock(clock0, rate); clock_last = clock0
 
     do while (model%t < cfg%t_end * (1.0_wp - 1.0e-12_wp))
@@ -165,6 +195,9 @@ contains
       if (len(msg) > 0) then
         call restore(); call fail(msg); return
       end if
+      st%steps = st%steps + 1
+      st%dt_min = min(st%dt_min, dt); st%dt_max = max(st%dt_max, dt)
+      call add_gravity_work()
 
       if (mod(model%step, cfg%history_every) == 0 .or. model%t >= cfg%t_end) then
         call empm_energies(model, psi, ekin, estr, egrav)
@@ -173,9 +206,33 @@ contains
       call skip_past_snapshots()
       if (show) call progress()
     end do
-    if (show) write(error_unit, '(a)') ''
+    if (show .and. tty) write(error_unit, '(a)') ''
+    call finish_stats()
 
   contains
+
+    ! The potential −Σ m g(t)·x changes with g(t) too: the ramp's work, so that the energy
+    ! balance of the summary can subtract it. Diagnostics only (the state is not touched).
+    subroutine add_gravity_work()
+      real(wp) :: g0(3), g1(3)
+      integer :: d, np
+      g0 = model%loads%gravity_at(t_good); g1 = model%loads%gravity_at(model%t)
+      if (all(g0 == g1)) return
+      d = model%grid%ndim; np = model%pts%np
+      st%work_gravity = st%work_gravity - sum(model%pts%m(1:np) * matmul(g1(1:d) - g0(1:d), &
+        0.5_wp * (good%x(:, 1:np) + model%pts%x(:, 1:np))))
+    end subroutine add_gravity_work
+
+    ! The statistics of the run so far (the model holds the last good state).
+    subroutine finish_stats()
+      call system_clock(clock)
+      st%wall = real(clock - clock0, wp) / real(rate, wp)
+      if (st%steps == 0) st%dt_min = 0.0_wp
+      st%t_reached = model%t; st%ran = .true.
+      call empm_energies(model, psi, ekin, estr, egrav)
+      st%energy_final = ekin + estr + egrav
+      if (present(stats)) stats = st
+    end subroutine finish_stats
 
     subroutine skip_past_snapshots()
       do while (isnap <= nsnap)
@@ -196,24 +253,41 @@ contains
       character(len=*), intent(in) :: text
       integer, intent(in), optional :: particle
       type(empm_error_t) :: ef
-      if (show) write(error_unit, '(a)') ''
+      if (show .and. tty) write(error_unit, '(a)') ''
+      call finish_stats()
       ef%code = EMPM_ERR_RUNTIME; ef%message = text; ef%step = model%step + 1
       if (present(particle)) ef%particle = particle
       call empm_raise_error(ef, err)
     end subroutine fail
 
+    ! On a terminal one line rewritten twice a second; elsewhere (a batch log) a plain line
+    ! each tenth of the run or every 10 s, whichever comes first.
     subroutine progress()
-      real(wp) :: elapsed, sps, eta
+      real(wp) :: elapsed, sps, eta, since
       character(len=160) :: line
+      integer :: ios
       call system_clock(clock)
-      if (real(clock - clock_last, wp) < 0.5_wp * real(rate, wp) .and. model%t < cfg%t_end) return
+      since = real(clock - clock_last, wp) / real(rate, wp)
+      if (tty) then
+        if (since < 0.5_wp .and. model%t < cfg%t_end) return
+      else
+        if (since < 10.0_wp .and. model%t < t_report * (1.0_wp - 1.0e-12_wp)) return
+        do while (t_report <= model%t * (1.0_wp + 1.0e-12_wp))
+          t_report = t_report + 0.1_wp * (cfg%t_end - st%t_start)
+        end do
+      end if
       clock_last = clock
       elapsed = real(clock - clock0, wp) / real(rate, wp)
-      sps = real(model%step, wp) / max(elapsed, 1.0e-9_wp)
-      eta = elapsed * (cfg%t_end - model%t) / max(model%t, tiny(1.0_wp))
+      sps = real(st%steps, wp) / max(elapsed, 1.0e-9_wp)
+      eta = elapsed * (cfg%t_end - model%t) / max(model%t - st%t_start, tiny(1.0_wp))
       write(line, '(a,es10.3,a,es10.3,a,i0,a,f10.1,a,f8.1,a)') 't = ', model%t, ' / ', &
         cfg%t_end, ' s  step ', model%step, '  ', sps, ' steps/s  ETA ', eta, ' s'
-      write(error_unit, '(a)', advance='no') achar(13)//trim(line)
+      if (tty) then
+        write(error_unit, '(a)', advance='no', iostat=ios) achar(13)//trim(line)
+      else
+        write(error_unit, '(a,i3,a)', iostat=ios) 'empm: ', &
+          nint(100.0_wp * (model%t - st%t_start) / (cfg%t_end - st%t_start)), '%  '//trim(line)
+      end if
       flush(error_unit)
     end subroutine progress
 
@@ -301,6 +375,39 @@ contains
       if (k <= size(names)) t = t//' ('//trim(names(k))//')'
     end function state_label
   end function empm_check_guards
+
+  !> One line for the end of a run: steps, time-step range, wall time and energy balance, e.g.
+  !> `120 steps to t = 5.0E-01 s, dt 4.1E-03..4.2E-03 s, wall 0.01 s; energy 1.0E-03 -> 1.0E-03 J
+  !> (drift -2.1E-06)`, with `, gravity ramp work W J` before the drift when gravity varies.
+  !> The drift is (E_final − E_initial − W) / max(|E_initial|, |E_final|, |W|) of the total
+  !> energy (kinetic + strain + gravity potential); work done by prescribed non-zero boundary
+  !> velocities is not subtracted and shows in it.
+  function empm_run_summary(st) result(s)
+    type(empm_run_stats_t), intent(in) :: st !! statistics of a run
+    character(len=:), allocatable :: s       !! the line (no trailing newline)
+    character(len=40) :: a, b, c, e0, e1, w, drift
+    real(wp) :: scale
+    write(a, '(es10.3)') st%t_reached
+    write(b, '(es10.3)') st%dt_min
+    write(c, '(es10.3)') st%dt_max
+    write(w, '(f12.2)') st%wall
+    scale = max(abs(st%energy_initial), abs(st%energy_final), abs(st%work_gravity))
+    if (scale > 0.0_wp) then
+      write(drift, '(es10.2)') (st%energy_final - st%energy_initial - st%work_gravity) / scale
+    else
+      drift = '0'
+    end if
+    write(e0, '(es12.5)') st%energy_initial
+    write(e1, '(es12.5)') st%energy_final
+    s = str(st%steps)//' steps to t = '//trim(adjustl(a))//' s, dt '//trim(adjustl(b))//'..'// &
+      trim(adjustl(c))//' s, wall '//trim(adjustl(w))//' s; energy '//trim(adjustl(e0))// &
+      ' -> '//trim(adjustl(e1))//' J'
+    if (st%work_gravity /= 0.0_wp) then
+      write(e0, '(es12.5)') st%work_gravity
+      s = s//', gravity ramp work '//trim(adjustl(e0))//' J'
+    end if
+    s = s//' (drift '//trim(adjustl(drift))//')'
+  end function empm_run_summary
 
   pure function vec(x) result(s)
     real(wp), intent(in) :: x(:)

@@ -1,8 +1,12 @@
 # Run one empm command line and check its exit status, its output and the files it leaves.
 # -DEXE=... -DARGS="a;b" -DEXPECT_RC=n [-DEXPECT_REGEX=re] [-DEXPECT_FILE=f] [-DNO_FILE=f]
-# [-DWORK_DIR=d]
+# [-DWORK_DIR=d] [-DMAKE_DIR=d] (a folder to create first, e.g. to block an output name)
+# [-DNOT_REGEX=re] (must not appear in the output)
 if(WORK_DIR)
   file(MAKE_DIRECTORY ${WORK_DIR})
+endif()
+if(MAKE_DIR)
+  file(MAKE_DIRECTORY ${MAKE_DIR})
 endif()
 if(EXPECT_FILE)
   file(REMOVE ${EXPECT_FILE})
@@ -15,6 +19,9 @@ if(NOT "${rc}" STREQUAL "${EXPECT_RC}")
 endif()
 if(EXPECT_REGEX AND NOT "${out}${err}" MATCHES "${EXPECT_REGEX}")
   message(FATAL_ERROR "output does not match '${EXPECT_REGEX}'")
+endif()
+if(NOT_REGEX AND "${out}${err}" MATCHES "${NOT_REGEX}")
+  message(FATAL_ERROR "output matches '${NOT_REGEX}'")
 endif()
 if(EXPECT_FILE AND NOT EXISTS ${EXPECT_FILE})
   message(FATAL_ERROR "expected file ${EXPECT_FILE} is missing")
