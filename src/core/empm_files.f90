@@ -2,10 +2,11 @@
 !> publish output files atomically and to create output folders.
 module empm_files
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_error, only: empm_error_t, EMPM_ERR_IO
   implicit none
   private
-  public :: empm_rename, empm_remove, empm_mkdir_p, empm_read_text
+  public :: empm_rename, empm_remove, empm_mkdir_p, empm_read_text, empm_physical_memory
 
   interface
     function c_rename(old, new) bind(C, name='rename') result(r)
@@ -81,4 +82,26 @@ contains
     end if
     close(u)
   end subroutine empm_read_text
+
+  !> Physical memory of the machine [bytes] (MemTotal of /proc/meminfo), or -1 when unknown
+  !> (not Linux): the limit a case's memory estimate is checked against.
+  function empm_physical_memory() result(bytes)
+    integer(int64) :: bytes !! physical memory [bytes], or -1
+    character(len=256) :: line
+    integer :: u, ios
+    integer(int64) :: kib
+    bytes = -1
+    open(newunit=u, file='/proc/meminfo', action='read', status='old', iostat=ios)
+    if (ios /= 0) return
+    do
+      read(u, '(a)', iostat=ios) line
+      if (ios /= 0) exit
+      if (line(1:9) == 'MemTotal:') then
+        read(line(10:), *, iostat=ios) kib
+        if (ios == 0) bytes = 1024_int64 * kib
+        exit
+      end if
+    end do
+    close(u)
+  end function empm_physical_memory
 end module empm_files

@@ -553,6 +553,10 @@ contains
     if (k > 0) then
       self%kv(k)%used = .true.
       n = self%kv(k)%n
+      if (n == 0) then
+        call self%fail(err, p%name, 'no value given (a null value such as ''3*'' sets nothing)')
+        return
+      end if
       if (n > p%count) then
         if (p%count == 1) then
           call self%fail(err, p%name, 'expected one value, got '//str(n))

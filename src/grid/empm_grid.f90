@@ -3,7 +3,7 @@
 !> Nodes are numbered lexicographically, x fastest: node (i,j,k), 0-based per direction,
 !> has index `1 + i + n1*(j + n2*k)` with `n1, n2` the node counts along x and y.
 module empm_grid
-  use empm_kinds, only: wp
+  use empm_kinds, only: wp, int64 => i8
   implicit none
   private
   public :: empm_grid_t
@@ -36,7 +36,8 @@ contains
     real(wp), intent(in) :: origin(:)         !! origin, at least `ndim` entries
     real(wp), intent(in) :: h(:)              !! cell sizes (> 0), at least `ndim` entries
     integer, intent(in) :: ncell(:)           !! cells per direction (>= 1), at least `ndim` entries
-    integer, intent(out) :: info              !! 0 ok, 1 bad dimension, 2 bad spacing, 3 bad cells
+    integer, intent(out) :: info              !! 0 ok, 1 bad dimension, 2 bad spacing, 3 bad cells,
+                                              !! 4 more nodes than a default integer counts
     info = 0
     if (ndim < 1 .or. ndim > 3) then
       info = 1; return
@@ -46,6 +47,10 @@ contains
     end if
     if (any(ncell(1:ndim) < 1)) then
       info = 3; return
+    end if
+    ! Node ids are default integers: the node count, formed in 64 bits, must fit.
+    if (product(int(ncell(1:ndim), int64) + 1_int64) > int(huge(1), int64)) then
+      info = 4; return
     end if
     self%ndim = ndim
     self%origin = 0.0_wp; self%h = 1.0_wp; self%ncell = 0; self%nn = 1

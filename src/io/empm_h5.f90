@@ -1,14 +1,18 @@
 !> Thin helpers over HDF5's Fortran API: create groups, write real/integer datasets and
-!> scalar/string attributes, with one error flag threaded through.
+!> scalar/string attributes, with one error flag threaded through; open a file read-only and
+!> read real datasets (bodies from HDF5 point lists).
 module empm_h5
   use hdf5, only: hid_t, hsize_t, size_t, h5gcreate_f, h5gclose_f, &
     h5screate_simple_f, h5screate_f, h5sclose_f, h5dcreate_f, h5dwrite_f, h5dclose_f, &
     h5acreate_f, h5awrite_f, h5aclose_f, h5tcopy_f, h5tset_size_f, h5tclose_f, &
-    H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_NATIVE_CHARACTER, H5S_SCALAR_F
+    H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_NATIVE_CHARACTER, H5S_SCALAR_F, &
+    h5open_f, h5fopen_f, h5fclose_f, h5fis_hdf5_f, H5F_ACC_RDONLY_F, h5lexists_f, h5dopen_f, &
+    h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5dread_f
   use empm_kinds, only: wp
   implicit none
   private
   public :: hid_t, h5_group, h5_close_group, h5_write, h5_attr
+  public :: h5_open_read, h5_close_file, h5_exists, h5_dims, h5_read
 
   !> Write a dataset (real rank 1–2, integer rank 1).
   interface h5_write
@@ -19,6 +23,11 @@ module empm_h5
   interface h5_attr
     module procedure attr_r0, attr_r1, attr_i0, attr_s
   end interface h5_attr
+
+  !> Read a real dataset of known shape (rank 1–2), converting from its stored type.
+  interface h5_read
+    module procedure read_r1, read_r2
+  end interface h5_read
 
 contains
 
@@ -161,5 +170,117 @@ contains
     call h5aclose_f(aid, e(6)); call h5sclose_f(sid, e(3)); call h5tclose_f(tid, e(1))
     if (any(e /= 0)) ierr = 1
   end subroutine attr_s
+
+  ! ---- reading ------------------------------------------------------------------------------
+
+  !> Open an existing HDF5 file read-only. `ierr` is 1 when the file does not exist, 2 when it
+  !> is not an HDF5 file, 3 when it cannot be opened (checked in that order, so that the HDF5
+  !> library prints no error stack for the first two).
+  subroutine h5_open_read(path, fid, ierr)
+    character(len=*), intent(in) :: path   !! file
+    integer(hid_t), intent(out) :: fid     !! open file
+    integer, intent(out) :: ierr           !! 0 on success
+    logical :: there, is_h5
+    integer :: e
+    fid = -1; ierr = 0
+    inquire(file=path, exist=there)
+    if (.not. there) then
+      ierr = 1; return
+    end if
+    call h5open_f(e)
+    call h5fis_hdf5_f(path, is_h5, e)
+    if (e /= 0 .or. .not. is_h5) then
+      ierr = 2; return
+    end if
+    call h5fopen_f(path, H5F_ACC_RDONLY_F, fid, e)
+    if (e /= 0) ierr = 3
+  end subroutine h5_open_read
+
+  !> Close a file opened by [[h5_open_read]].
+  subroutine h5_close_file(fid, ierr)
+    integer(hid_t), intent(in) :: fid   !! file
+    integer, intent(inout) :: ierr      !! set non-zero on failure
+    integer :: e
+    call h5fclose_f(fid, e)
+    if (e /= 0) ierr = e
+  end subroutine h5_close_file
+
+  !> True when `loc` has a link called `name` (a dataset or group directly under it).
+  logical function h5_exists(loc, name) result(there)
+    integer(hid_t), intent(in) :: loc       !! file or group
+    character(len=*), intent(in) :: name    !! link name (no '/')
+    integer :: e
+    call h5lexists_f(loc, name, there, e)
+    if (e /= 0) there = .false.
+  end function h5_exists
+
+  !> Dimensions of dataset `name` in Fortran order (an array written from C or Python with
+  !> shape (n, 3) reads as (3, n)); `ierr` non-zero when it cannot be opened.
+  subroutine h5_dims(loc, name, dims, ierr)
+    integer(hid_t), intent(in) :: loc                  !! file or group
+    character(len=*), intent(in) :: name               !! dataset
+    integer(hsize_t), allocatable, intent(out) :: dims(:) !! extent per dimension
+    integer, intent(inout) :: ierr                     !! set non-zero on failure
+    integer(hid_t) :: did, sid
+    integer(hsize_t) :: maxdims(8)
+    integer :: e, rank, bad
+    allocate(dims(0))
+    call h5dopen_f(loc, name, did, e)
+    if (e /= 0) then
+      ierr = 1; return
+    end if
+    bad = 0; rank = -1
+    call h5dget_space_f(did, sid, e)
+    if (e /= 0) bad = 1
+    if (bad == 0) call h5sget_simple_extent_ndims_f(sid, rank, e)
+    if (bad == 0 .and. e == 0 .and. rank >= 0 .and. rank <= 8) then
+      deallocate(dims); allocate(dims(rank))
+      ! hdferr is the rank on success, -1 on failure.
+      if (rank > 0) call h5sget_simple_extent_dims_f(sid, dims, maxdims(1:rank), e)
+      if (e < 0) bad = 1
+    else
+      bad = 1
+    end if
+    call h5sclose_f(sid, e); call h5dclose_f(did, e)
+    if (bad /= 0) ierr = 1
+  end subroutine h5_dims
+
+  !> Read the rank-1 dataset `name` into `a` (sized to the dataset, see [[h5_dims]]).
+  subroutine read_r1(loc, name, a, ierr)
+    integer(hid_t), intent(in) :: loc        !! file or group
+    character(len=*), intent(in) :: name     !! dataset
+    real(wp), intent(inout) :: a(:)          !! values (contiguous, the dataset's shape)
+    integer, intent(inout) :: ierr           !! set non-zero on failure
+    integer(hsize_t) :: dims(1)
+    integer(hid_t) :: did
+    integer :: e(3)
+    dims = shape(a, kind=hsize_t); e = 0
+    call h5dopen_f(loc, name, did, e(1))
+    if (e(1) /= 0) then
+      ierr = 1; return
+    end if
+    call h5dread_f(did, H5T_NATIVE_DOUBLE, a, dims, e(2))
+    call h5dclose_f(did, e(3))
+    if (any(e /= 0)) ierr = 1
+  end subroutine read_r1
+
+  !> Read the rank-2 dataset `name` into `a` (sized to the dataset in Fortran order).
+  subroutine read_r2(loc, name, a, ierr)
+    integer(hid_t), intent(in) :: loc        !! file or group
+    character(len=*), intent(in) :: name     !! dataset
+    real(wp), intent(inout) :: a(:,:)        !! values (contiguous, the dataset's shape)
+    integer, intent(inout) :: ierr           !! set non-zero on failure
+    integer(hsize_t) :: dims(2)
+    integer(hid_t) :: did
+    integer :: e(3)
+    dims = shape(a, kind=hsize_t); e = 0
+    call h5dopen_f(loc, name, did, e(1))
+    if (e(1) /= 0) then
+      ierr = 1; return
+    end if
+    call h5dread_f(did, H5T_NATIVE_DOUBLE, a, dims, e(2))
+    call h5dclose_f(did, e(3))
+    if (any(e /= 0)) ierr = 1
+  end subroutine read_r2
 
 end module empm_h5

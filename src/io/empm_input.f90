@@ -10,10 +10,12 @@
 !> an error with code EMPM_ERR_INPUT (exit status 2) naming the file, the line, the group, the
 !> key and what was expected.
 module empm_input
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
+  use empm_parallel, only: empm_max_threads
   use empm_error, only: empm_error_t, empm_raise_error, EMPM_ERR_INPUT, EMPM_OK
-  use empm_strings, only: str
-  use empm_files, only: empm_read_text
+  use empm_strings, only: str, str_short
+  use empm_files, only: empm_read_text, empm_physical_memory
   use empm_params, only: empm_param_t, empm_param, empm_params_markdown, PARAM_REAL, PARAM_INT, &
                          PARAM_STR, PARAM_LOGICAL
   use empm_namelist, only: empm_group_t, empm_parse_namelist
@@ -24,6 +26,7 @@ module empm_input
   use empm_shape, only: shape_status_text
   use empm_registry, only: empm_registry_t, empm_default_registry
   use empm_solver, only: empm_run_params
+  use empm_bodies, only: empm_body_points_t, empm_read_body, empm_body_path
   implicit none
   private
   public :: empm_read_case, empm_input_markdown, empm_input_group_params
@@ -32,6 +35,9 @@ module empm_input
                                           'boundary probe output'
   character(len=*), parameter :: REPEATABLE = 'material particles boundary probe'
   integer, parameter :: MAXSNAP = 1000          !! capacity of output%snapshot_times
+  !> Largest magnitude of a length or coordinate [m] (and of a speed [m/s], an acceleration
+  !> [m/s²]): beyond it the products a step forms (x², m v², σ V) overflow double precision.
+  real(wp), parameter :: LMAX = 1.0e15_wp
 
 contains
 
@@ -48,11 +54,12 @@ contains
         empm_param('ndim', PARAM_INT, '-', 'spatial dimension: 1 (uniaxial strain), 2 (plane '// &
           'strain) or 3', lo=1.0_wp, hi=3.0_wp), &
         empm_param('origin', PARAM_REAL, 'm', 'coordinates of the first node', default='0', &
-          count=3), &
+          count=3, lo=-LMAX, hi=LMAX), &
         empm_param('h', PARAM_REAL, 'm', 'cell size per direction; one value applies to every '// &
-          'direction', count=3, lo=0.0_wp, lo_open=.true.), &
-        empm_param('cells', PARAM_INT, '-', 'number of cells per direction (ndim values)', &
-          count=3, lo=1.0_wp)]
+          'direction', count=3, lo=0.0_wp, lo_open=.true., hi=LMAX), &
+        empm_param('cells', PARAM_INT, '-', 'number of cells per direction (ndim values); the '// &
+          'grid must fit in memory (checked before allocating)', count=3, lo=1.0_wp, &
+          hi=1.0e8_wp)]
     case ('material')
       p = [ &
         empm_param('name', PARAM_STR, '-', 'label referenced by &particles material (unique)'), &
@@ -61,30 +68,36 @@ contains
     case ('particles')
       p = [ &
         empm_param('material', PARAM_STR, '-', 'a &material name'), &
-        empm_param('geometry', PARAM_STR, '-', 'body shape: box (interval in 1D) or disk '// &
-          '(sphere in 3D, ndim >= 2)', default='''box''', choices='box interval disk sphere'), &
+        empm_param('geometry', PARAM_STR, '-', 'body shape: box (interval in 1D), disk '// &
+          '(sphere in 3D, ndim >= 2) or file (points or mesh read from `file`)', &
+          default='''box''', choices='box interval disk sphere file'), &
         empm_param('lo', PARAM_REAL, 'm', 'box: lower corner (required for a box)', count=3, &
-          optional=.true.), &
+          lo=-LMAX, hi=LMAX, optional=.true.), &
         empm_param('hi', PARAM_REAL, 'm', 'box: upper corner, hi > lo (required for a box)', &
-          count=3, optional=.true.), &
+          count=3, lo=-LMAX, hi=LMAX, optional=.true.), &
         empm_param('center', PARAM_REAL, 'm', 'disk: centre (required for a disk)', count=3, &
-          optional=.true.), &
+          lo=-LMAX, hi=LMAX, optional=.true.), &
         empm_param('radius', PARAM_REAL, 'm', 'disk: radius (required for a disk)', &
-          lo=0.0_wp, lo_open=.true., optional=.true.), &
-        empm_param('ppc', PARAM_INT, '-', 'particles per cell per direction (ppc^ndim per cell)', &
-          default='2', lo=1.0_wp, hi=4.0_wp), &
+          lo=0.0_wp, lo_open=.true., hi=LMAX, optional=.true.), &
+        empm_param('file', PARAM_STR, '-', 'file: point list (.csv, .h5/.hdf5) or Gmsh 4.1 '// &
+          'mesh (.msh), relative to the case file''s folder (required for a file)', &
+          optional=.true.), &
+        empm_param('ppc', PARAM_INT, '-', 'particles per cell per direction (ppc^ndim per '// &
+          'cell); for a mesh, the quadrature order per direction', default='2', lo=1.0_wp, &
+          hi=4.0_wp), &
         empm_param('placement', PARAM_STR, '-', 'gauss: Gauss-Legendre points, volume = Gauss '// &
           'weight x cell volume; voxel: centres of ppc^ndim equal sub-cells', &
           default='''gauss''', choices='gauss voxel'), &
         empm_param('velocity', PARAM_REAL, 'm/s', 'uniform initial velocity', default='0', &
-          count=3), &
+          count=3, lo=-LMAX, hi=LMAX), &
         empm_param('velocity_sine_amplitude', PARAM_REAL, 'm/s', 'A in v += A sin(k.x + phi)', &
-          default='0', count=3), &
+          default='0', count=3, lo=-LMAX, hi=LMAX), &
         empm_param('velocity_sine_wavenumber', PARAM_REAL, '1/m', 'k in the same', &
-          default='0', count=3), &
-        empm_param('velocity_sine_phase', PARAM_REAL, 'rad', 'phi in the same', default='0'), &
+          default='0', count=3, lo=-LMAX, hi=LMAX), &
+        empm_param('velocity_sine_phase', PARAM_REAL, 'rad', 'phi in the same', default='0', &
+          lo=-LMAX, hi=LMAX), &
         empm_param('stress', PARAM_REAL, 'Pa', 'uniform initial Cauchy stress, Voigt order '// &
-          'xx, yy, zz, yz, xz, xy', default='0', count=6)]
+          'xx, yy, zz, yz, xz, xy', default='0', count=6, lo=-1.0e30_wp, hi=1.0e30_wp)]
     case ('shape')
       p = [empm_param('family', PARAM_STR, '-', 'shape-function family (see the families '// &
         'below), or an identifier that also sets tagged parameters, e.g. ''lme_g0.8''', &
@@ -95,29 +108,29 @@ contains
     case ('loads')
       p = [ &
         empm_param('gravity', PARAM_REAL, 'm/s^2', 'gravity vector (final value)', &
-          default='0', count=3), &
+          default='0', count=3, lo=-LMAX, hi=LMAX), &
         empm_param('ramp', PARAM_STR, '-', 'none (constant) or sine: the paper''s eq. (46), '// &
           'g(t) = g (sin(2 pi t/T - pi/2) + 1)/2 for t <= T/2, g after', default='''none''', &
           choices='none sine'), &
         empm_param('ramp_time', PARAM_REAL, 's', 'T of eq. (46) (required with ramp = sine)', &
-          lo=0.0_wp, lo_open=.true., optional=.true.)]
+          lo=0.0_wp, lo_open=.true., hi=LMAX, optional=.true.)]
     case ('boundary')
       p = [ &
         empm_param('lo', PARAM_REAL, 'm', 'lower corner of the box selecting the nodes', &
-          count=3), &
+          count=3, lo=-LMAX, hi=LMAX), &
         empm_param('hi', PARAM_REAL, 'm', 'upper corner of the box selecting the nodes', &
-          count=3), &
+          count=3, lo=-LMAX, hi=LMAX), &
         empm_param('fix', PARAM_LOGICAL, '-', 'which velocity components are prescribed '// &
           '(at least one)', default='.false.', count=3), &
         empm_param('velocity', PARAM_REAL, 'm/s', 'prescribed velocity of the fixed components', &
-          default='0', count=3)]
+          default='0', count=3, lo=-LMAX, hi=LMAX)]
     case ('probe')
       p = [ &
         empm_param('name', PARAM_STR, '-', 'probe name (HDF5 group /probes/<name>)'), &
         empm_param('particle', PARAM_INT, '-', 'follow this particle (1-based index in '// &
           'generation order)', lo=1.0_wp, optional=.true.), &
         empm_param('point', PARAM_REAL, 'm', 'follow the particle nearest to this point at '// &
-          't = 0', count=3, optional=.true.)]
+          't = 0', count=3, lo=-LMAX, hi=LMAX, optional=.true.)]
     case ('output')
       p = [ &
         empm_param('file', PARAM_STR, '-', 'HDF5 output (overridden by empm run -o); '// &
@@ -125,7 +138,8 @@ contains
         empm_param('history_every', PARAM_INT, '-', 'sample energies and probes every n steps '// &
           '(and at t_end)', default='1', lo=1.0_wp), &
         empm_param('snapshot_times', PARAM_REAL, 's', 'increasing times in [0, t_end] at '// &
-          'which the particle state is stored', count=MAXSNAP, lo=0.0_wp, optional=.true.)]
+          'which the particle state is stored', count=MAXSNAP, lo=0.0_wp, hi=LMAX, &
+          optional=.true.)]
     case default
       allocate(p(0))
     end select
@@ -292,6 +306,7 @@ contains
     type(empm_param_t), allocatable :: p(:)
     type(empm_group_t) :: g
     integer :: ndim, cells(3), info, n
+    integer(int64) :: nnode, bytes, mem
     real(wp) :: origin(3), h(3)
     if (first(gs, 'grid') == 0) then
       call missing_group(path, 'grid', e); return
@@ -311,7 +326,26 @@ contains
       call g%fail(e, 'cells', 'expected '//str(ndim)//' cell counts (one per direction), got '// &
         str(n)); return
     end if
+    ! Counts in 64 bits: cells x refine and the node count can exceed 2^31.
+    if (any(int(cells(1:ndim), int64) * ov%refine > 100000000_int64)) then
+      call g%fail(e, 'cells', 'expected at most 1e8 cells per direction after refinement '// &
+        'by '//str(ov%refine)); return
+    end if
     h = h / ov%refine; cells = cells * ov%refine
+    nnode = product(int(cells(1:ndim), int64) + 1_int64)
+    if (nnode > int(huge(1), int64)) then
+      call g%fail(e, 'cells', 'the grid has '//str(real(nnode, wp))//' nodes, more than '// &
+        str(huge(1))//' (node numbers are default integers)'); return
+    end if
+    ! Nodal fields (mass, 6 vectors, the constraint mask) and the per-thread P2G buffers.
+    bytes = nnode * (8_int64 + 52_int64 * ndim) + &
+      (empm_max_threads() - 1) * nnode * 8_int64 * (ndim + 1)
+    mem = empm_physical_memory()
+    if (mem > 0 .and. bytes > mem) then
+      call g%fail(e, 'cells', 'the grid ('//str(real(nnode, wp))//' nodes) needs about '// &
+        str_short(real(bytes, wp) / 2.0_wp**30)//' GiB of node storage, more than this '// &
+        'machine''s '//str_short(real(mem, wp) / 2.0_wp**30)//' GiB'); return
+    end if
     call cs%model%grid%init(ndim, origin, h, cells, info)
     if (info /= 0) then
       ! Not reachable after the checks above; kept so that no grid error passes silently.
@@ -342,6 +376,9 @@ contains
       call g%get(p(1), name, e)
       call g%get(p(2), model, e)
       if (e%code /= EMPM_OK) return
+      if (len_trim(name) == 0) then
+        call g%fail(e, 'name', 'expected a label (material '//str(n)//')'); return
+      end if
       do i = 1, n - 1
         if (cs%model%mats(i)%label == name) then
           call g%fail(e, 'name', 'duplicate label '''//name//''''); return
@@ -391,10 +428,11 @@ contains
     type(empm_error_t), intent(inout) :: e
     type(empm_param_t), allocatable :: p(:)
     type(empm_group_t) :: g
-    character(len=:), allocatable :: material, geometry, placement
+    character(len=:), allocatable :: material, geometry, placement, file
     real(wp) :: lo(3), hi(3), center(3), radius, velocity(3), amp(3), wavenumber(3), phase, &
                 stress(6)
     integer :: ppc, info, nbody, imat, i, geom, place, nadded, p0, q, nd, k, n, nlo, nhi, nc
+    type(empm_body_points_t) :: body
     allocate(p, source=empm_input_group_params('particles'))
     nd = cs%model%grid%ndim
     nbody = 0
@@ -403,7 +441,7 @@ contains
       g = gs(k)
       nbody = nbody + 1
       call g%check_keys(p, e)
-      material = ''; geometry = 'box'; placement = 'gauss'; ppc = 2
+      material = ''; geometry = 'box'; placement = 'gauss'; ppc = 2; file = ''
       lo = 0.0_wp; hi = 0.0_wp; center = 0.0_wp; radius = 0.0_wp
       velocity = 0.0_wp; amp = 0.0_wp; wavenumber = 0.0_wp; phase = 0.0_wp; stress = 0.0_wp
       call g%get(p(1), material, e)
@@ -412,13 +450,14 @@ contains
       call g%get(p(4), hi, nhi, e)
       call g%get(p(5), center, nc, e)
       call g%get(p(6), radius, e)
-      call g%get(p(7), ppc, e)
-      call g%get(p(8), placement, e)
-      call g%get(p(9), velocity, n, e)
-      call g%get(p(10), amp, n, e)
-      call g%get(p(11), wavenumber, n, e)
-      call g%get(p(12), phase, e)
-      call g%get(p(13), stress, n, e)
+      call g%get(p(7), file, e)
+      call g%get(p(8), ppc, e)
+      call g%get(p(9), placement, e)
+      call g%get(p(10), velocity, n, e)
+      call g%get(p(11), amp, n, e)
+      call g%get(p(12), wavenumber, n, e)
+      call g%get(p(13), phase, e)
+      call g%get(p(14), stress, n, e)
       if (e%code /= EMPM_OK) return
       imat = 0
       do i = 1, size(cs%model%mats)
@@ -428,7 +467,15 @@ contains
         call g%fail(e, 'material', 'expected the name of a &material group, got '''// &
           material//''' (body '//str(nbody)//')'); return
       end if
+      if (geometry /= 'file' .and. g%has('file')) then
+        call g%fail(e, 'file', 'used with geometry = ''file'' only (body '//str(nbody)//')')
+        return
+      end if
       select case (geometry)
+      case ('file')
+        call read_file_body()
+        if (e%code /= EMPM_OK) return
+        cycle
       case ('box', 'interval')
         geom = GEOM_BOX
         if (nlo < nd .or. nhi < nd) then
@@ -468,6 +515,66 @@ contains
       end do
     end do
     if (nbody == 0) call missing_group(path, 'particles', e)
+
+  contains
+
+    !> geometry = 'file': one particle per point of the list or quadrature point of the mesh,
+    !> with the group's material; velocity and stress from the file, else from the keys.
+    subroutine read_file_body()
+      character(len=9), parameter :: SHAPE_KEYS(5) = [character(len=9) :: 'lo', 'hi', &
+        'center', 'radius', 'placement']
+      character(len=:), allocatable :: full
+      real(wp) :: lp(3)
+      integer :: j
+      if (.not. g%has('file') .or. len_trim(file) == 0) then
+        call g%fail(e, 'file', 'required for geometry = ''file'': a point list (.csv, .h5) '// &
+          'or a Gmsh mesh (.msh) (body '//str(nbody)//')'); return
+      end if
+      do j = 1, size(SHAPE_KEYS)
+        if (g%has(trim(SHAPE_KEYS(j)))) then
+          call g%fail(e, trim(SHAPE_KEYS(j)), 'not used with geometry = ''file'' (body '// &
+            str(nbody)//')'); return
+        end if
+      end do
+      full = empm_body_path(path, file)
+      call empm_read_body(full, nd, ppc, body, e)
+      if (e%code /= EMPM_OK) then
+        ! The file's own location first, then the group that asked for it.
+        e%message = e%message//' (&particles body '//str(nbody)//', '//path//':'// &
+          str(g%key_line('file'))//')'
+        return
+      end if
+      if (body%has_velocity .and. (g%has('velocity') .or. g%has('velocity_sine_amplitude'))) &
+        then
+        call g%fail(e, 'velocity', 'the file '''//file//''' gives velocities: give them '// &
+          'there or with the velocity keys, not both (body '//str(nbody)//')'); return
+      end if
+      if (body%has_stress .and. g%has('stress')) then
+        call g%fail(e, 'stress', 'the file '''//file//''' gives stresses: give them there '// &
+          'or with the stress key, not both (body '//str(nbody)//')'); return
+      end if
+      p0 = cs%model%pts%np
+      do j = 1, body%n
+        ! uGIMP half-lengths: half the side of the cube (square, segment) of the volume.
+        lp = 0.0_wp
+        lp(1:nd) = 0.5_wp * body%vol(j)**(1.0_wp / nd)
+        call cs%model%pts%append(body%x(:, j), body%vol(j), cs%model%mats(imat)%model%rho0, &
+          lp(1:nd), imat, e)
+        if (e%code /= EMPM_OK) return
+        q = p0 + j
+        if (body%has_velocity) then
+          cs%model%pts%v(:, q) = body%v(:, j)
+        else
+          cs%model%pts%v(:, q) = velocity(1:nd) + amp(1:nd) * &
+            sin(sum(wavenumber(1:nd) * body%x(:, j)) + phase)
+        end if
+        if (body%has_stress) then
+          cs%model%pts%stress(:, q) = body%stress(:, j)
+        else
+          cs%model%pts%stress(:, q) = stress
+        end if
+      end do
+    end subroutine read_file_body
   end subroutine read_particles
 
   subroutine read_integrator(path, gs, cs, ov, reg, e)
@@ -611,6 +718,12 @@ contains
       end if
       if (any(names == name)) then
         call g%fail(e, 'name', 'duplicate probe name '''//name//''''); return
+      end if
+      ! The name becomes an HDF5 group: a '/' would make it a path.
+      if (verify(name, 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-') > 0 &
+          .or. len(name) == 0 .or. name == '.' .or. name == '..') then
+        call g%fail(e, 'name', 'expected letters, digits, ''_'', ''.'' or ''-'', got '''// &
+          name//''''); return
       end if
       if (g%has('particle') .eqv. g%has('point')) then
         call g%fail(e, 'particle', 'give exactly one of particle (index) or point '// &

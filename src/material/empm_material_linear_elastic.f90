@@ -51,8 +51,12 @@ contains
   pure function empm_elastic_params() result(p)
     type(empm_param_t), allocatable :: p(:) !! declarations
     p = [ &
-      empm_param('density', PARAM_REAL, 'kg/m3', 'initial density', lo=0.0_wp, lo_open=.true.), &
-      empm_param('E', PARAM_REAL, 'Pa', "Young's modulus", lo=0.0_wp, lo_open=.true.), &
+      ! The magnitudes are bounded so that the wave speed sqrt(E/rho) and the step's products
+      ! stay far from overflow (a density of 1e-308 made the CFL time step overflow).
+      empm_param('density', PARAM_REAL, 'kg/m3', 'initial density', lo=1.0e-30_wp, &
+        hi=1.0e30_wp), &
+      empm_param('E', PARAM_REAL, 'Pa', "Young's modulus", lo=0.0_wp, lo_open=.true., &
+        hi=1.0e30_wp), &
       empm_param('nu', PARAM_REAL, '-', "Poisson's ratio", default='0', lo=-1.0_wp, &
         hi=0.5_wp, lo_open=.true., hi_open=.true.)]
   end function empm_elastic_params
