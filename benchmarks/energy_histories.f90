@@ -150,7 +150,7 @@ contains
     if (err%code /= 0) write(*, '(27x,a)') 'stopped: '//err%message
   end subroutine run_one
 
-  !> Vibrating bar, first mode (docs/algorithms.md §3), as in tests/unit/test_energy.pf.
+  !> Vibrating bar, first mode (docs/benchmarks.md), as in tests/unit/test_energy.pf.
   subroutine build_bar(model, cfg, cfl)
     type(empm_model_t), intent(inout) :: model  !! model to set up
     type(empm_run_config_t), intent(out) :: cfg !! run controls
@@ -181,7 +181,7 @@ contains
     cfg%dt = cfl * h / sqrt(bar%E / bar%rho)
   end subroutine build_bar
 
-  !> Colliding disks (docs/algorithms.md §3, verification/colliding_disks.nml).
+  !> Colliding disks (docs/benchmarks.md, verification/colliding_disks.nml).
   subroutine build_disks(model, cfg, cfl)
     type(empm_model_t), intent(inout) :: model  !! model to set up
     type(empm_run_config_t), intent(out) :: cfg !! run controls

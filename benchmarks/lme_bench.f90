@@ -195,7 +195,7 @@ contains
       ': warm ', its / nevals, ' it/eval'
   end subroutine solver_run
 
-  !> Dyka bar (docs/algorithms.md §3): 40 cells, 1 particle per cell, x = 0 fixed, v0 = 5 m/s
+  !> Dyka bar (docs/benchmarks.md): 40 cells, 1 particle per cell, x = 0 fixed, v0 = 5 m/s
   !> on the last quarter.
   subroutine make_dyka(model, gamma)
     type(empm_model_t), intent(out) :: model
@@ -221,7 +221,7 @@ contains
     call check_created(err, 'Dyka bar shape')
   end subroutine make_dyka
 
-  !> Andersen block (docs/algorithms.md §3): 10 m × 10 m, h = 2 m, 2×2 Gauss particles per
+  !> Andersen block (docs/benchmarks.md): 10 m × 10 m, h = 2 m, 2×2 Gauss particles per
   !> cell, bottom fixed, side rollers, gravity ramped over 20 s.
   subroutine make_andersen(model, gamma)
     type(empm_model_t), intent(out) :: model

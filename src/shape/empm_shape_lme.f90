@@ -1,4 +1,4 @@
-!> Local maximum-entropy (LME) shape functions (Arroyo & Ortiz 2006; docs/algorithms.md §1).
+!> Local maximum-entropy (LME) shape functions (Arroyo & Ortiz 2006; docs/shape-functions.md).
 !>
 !> For a point x and candidate nodes a, with ξ_a = (x − x_a)/h and γ = β h² (dimensionless):
 !>
@@ -272,8 +272,9 @@ module empm_shape_lme
     end subroutine lme_eval_point_iters
 
     !> Values and gradients at particles 1..pts%np, warm-started by extrapolation from `pts%lam`
-    !> and `pts%lam_old` (the last two converged multipliers) and updating both;
-    !> stops at the first failing particle.
+    !> and `pts%lam_old` (the last two converged multipliers) and updating both; a particle
+    !> that fails from that start is retried from λ_n, then cold, before it counts as failed.
+    !> Reports the first failing particle.
     module subroutine lme_eval_batch(self, grid, pts, basis, ibad, info)
       class(empm_shape_lme_t), intent(in) :: self  !! shape family
       type(empm_grid_t), intent(in) :: grid        !! background grid

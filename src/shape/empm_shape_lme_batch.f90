@@ -10,7 +10,7 @@
 submodule (empm_shape_lme) empm_shape_lme_batch
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
   use empm_shape, only: SHAPE_OK, SHAPE_SUPPORT_CLIPPED, SHAPE_NOT_CONVERGED, SHAPE_OUTSIDE_HULL, &
-                        SHAPE_SINGULAR
+                        SHAPE_SINGULAR, SHAPE_OUTSIDE_GRID, SHAPE_TOO_MANY_NODES
   use empm_shape_linear, only: shape_batch_fits, shape_keep_first_failure
   implicit none
 
@@ -19,13 +19,13 @@ contains
   module procedure lme_eval_point
     integer :: iters
     associate (unused_lp_ => lp); end associate
-    call lme_point(self, grid, x, lam, 1.0_wp, nn, node, N, dN, iters, info)
+    call lme_point_retry(self, grid, x, lam, nn, node, N, dN, iters, info)
     if (info /= SHAPE_OK .and. self%remedy == LME_REMEDY_ENLARGE) &
       call lme_remedy(self, grid, x, lam, nn, node, N, dN, iters, info)
   end procedure lme_eval_point
 
   module procedure lme_eval_point_iters
-    call lme_point(self, grid, x, lam, 1.0_wp, nn, node, N, dN, iters, info)
+    call lme_point_retry(self, grid, x, lam, nn, node, N, dN, iters, info)
     if (info /= SHAPE_OK .and. self%remedy == LME_REMEDY_ENLARGE) &
       call lme_remedy(self, grid, x, lam, nn, node, N, dN, iters, info)
   end procedure lme_eval_point_iters
@@ -49,7 +49,7 @@ contains
     integer, intent(out) :: ibad                 !! first failing particle, 0 if none
     integer, intent(out) :: info                 !! SHAPE_OK or the failing particle's code
     integer, intent(out) :: iters                !! total Newton iterations
-    integer :: p, it, pinfo, nd
+    integer :: p, it, pinfo, nd, k
     real(wp) :: lam(3), hs, cut, rmax
     logical :: fast
     iters = 0
@@ -66,7 +66,7 @@ contains
     ibad = huge(1)
     !$omp parallel do default(none) schedule(static) &
     !$omp   shared(self, grid, pts, basis, fast, nd, hs, cut, rmax, ibad, info) &
-    !$omp   private(pinfo, it, lam) reduction(+: iters) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
+    !$omp   private(pinfo, it, lam, k) reduction(+: iters) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
       ! Warm start extrapolated from the last two converged multipliers: in a smooth motion
       ! λ* changes smoothly, so 2λ_n − λ_(n−1) is off by O(Δx²) and one Newton step usually
@@ -86,6 +86,22 @@ contains
         ! a separate call after a failure: the common call passes its arrays once.)
         call lme_point(self, grid, pts%x(:, p), lam(1:nd), 1.0_wp, basis%nn(p), &
                        basis%node(:, p), basis%N(:, p), basis%dN(:, :, p), it, pinfo)
+        ! A failed warm start is not a failed basis: near a face λ* grows like ln(1/ε), so the
+        ! extrapolation can overshoot into a region where J is numerically singular while a
+        ! nearer start converges. Retry from λ_n, then cold (λ = 0), before reporting.
+        do k = 1, 2
+          if (pinfo == SHAPE_OK .or. pinfo == SHAPE_OUTSIDE_GRID .or. &
+              pinfo == SHAPE_TOO_MANY_NODES) exit
+          if (k == 1) then
+            if (pts%lam_old(1, p) == huge(1.0_wp)) cycle  ! the first attempt started from λ_n
+            lam(1:nd) = pts%lam(:, p)
+          else
+            lam(1:nd) = 0.0_wp
+          end if
+          iters = iters + it
+          call lme_point(self, grid, pts%x(:, p), lam(1:nd), 1.0_wp, basis%nn(p), &
+                         basis%node(:, p), basis%N(:, p), basis%dN(:, :, p), it, pinfo)
+        end do
         if (pinfo /= SHAPE_OK .and. self%remedy == LME_REMEDY_ENLARGE) &
           call lme_remedy(self, grid, pts%x(:, p), lam(1:nd), basis%nn(p), basis%node(:, p), &
                           basis%N(:, p), basis%dN(:, :, p), it, pinfo)
@@ -313,6 +329,32 @@ contains
       jinv(1) = b22 / det; jinv(2) = -b12 / det; jinv(3) = b11 / det
     end subroutine inverse_2d
   end subroutine lme_batch
+
+  !> [[lme_point]] from the caller's warm start and, if that fails for a reason other than the
+  !> point's position or the storage, once more from λ = 0: a warm start is a hint, and a
+  !> failure from it says nothing about the basis at x.
+  pure subroutine lme_point_retry(self, grid, x, lam, nn, node, N, dN, iters, info)
+    type(empm_shape_lme_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid      !! background grid
+    real(wp), intent(in) :: x(:)               !! point (ndim)
+    real(wp), intent(inout) :: lam(:)          !! λ: warm start in, converged λ out
+    integer, intent(out) :: nn                 !! number of supporting nodes
+    integer, intent(out) :: node(:)            !! supporting node indices
+    real(wp), intent(out) :: N(:)              !! values
+    real(wp), intent(out) :: dN(:,:)           !! gradients (ndim, :)
+    integer, intent(out) :: iters              !! Newton iterations, both attempts
+    integer, intent(out) :: info               !! SHAPE_OK or the cold attempt's failure
+    integer :: it0
+    logical :: warm
+    warm = any(lam(1:grid%ndim) /= 0.0_wp)
+    call lme_point(self, grid, x, lam, 1.0_wp, nn, node, N, dN, iters, info)
+    if (info == SHAPE_OK .or. info == SHAPE_OUTSIDE_GRID .or. info == SHAPE_TOO_MANY_NODES &
+        .or. .not. warm) return
+    it0 = iters
+    lam(1:grid%ndim) = 0.0_wp
+    call lme_point(self, grid, x, lam, 1.0_wp, nn, node, N, dN, iters, info)
+    iters = iters + it0
+  end subroutine lme_point_retry
 
   !> The 'enlarge' remedy, after the first attempt at x failed with `info`: while the failure
   !> is one a larger support can cure, evaluate again from λ = 0 with every γ halved, then

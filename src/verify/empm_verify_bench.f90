@@ -1,7 +1,7 @@
 !> Benchmarks of the verification suite: the exact or manufactured solution behind each
 !> benchmark id, the initial state and body force it needs, the metrics computed from a run
 !> against it, and the exact fields stored beside the run for the report's plots.
-!> Definitions: ../shared/docs/algorithms.md §3; metrics: docs/verification.md.
+!> Definitions: docs/benchmarks.md; metrics: docs/verification.md.
 module empm_verify_bench
   use hdf5, only: h5open_f, h5fopen_f, h5fclose_f, H5F_ACC_RDWR_F
   use empm_kinds, only: wp, pi

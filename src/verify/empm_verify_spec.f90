@@ -27,6 +27,14 @@ module empm_verify_spec
     real(wp) :: max_order = huge(1.0_wp)         !! convergence study: order must stay below
                                                  !! (to assert a known loss of convergence)
     character(len=64) :: expect_fail(MAXLIST) = '' !! run-id patterns expected to fail a check
+    character(len=16) :: label = ''              !! variant of the study, part of its ids
+    !> The signature an expected failure must show (a known failure that stops showing it, or
+    !> that fails differently, fails its check): a matrix run either aborts (`expect_abort`) or
+    !> completes with an asserted metric above `expect_excess` times its threshold; a
+    !> convergence group completes every level with its observed order below `expect_order_below`.
+    logical :: expect_abort = .false.
+    real(wp) :: expect_excess = 0.0_wp
+    real(wp) :: expect_order_below = -huge(1.0_wp)
     integer :: quick_levels = 2                  !! convergence levels run in quick mode
     logical :: quick = .true.                    !! included in the quick subset
   end type empm_verify_spec_t
@@ -39,21 +47,25 @@ contains
     type(empm_verify_spec_t), intent(out) :: spec            !! the study
     character(len=:), allocatable, intent(out) :: emsg       !! '' or the problem
     character(len=*), parameter :: K = 'benchmark, study, shapes, schemes, levels, cfls, '// &
-      'metrics, thresholds, min_order, max_order, expect_fail, quick_levels, quick'
+      'metrics, thresholds, min_order, max_order, expect_fail, expect_abort, expect_excess, '// &
+      'expect_order_below, label, quick_levels, quick'
     character(len=32) :: benchmark, metrics(MAXLIST)
     character(len=64) :: expect_fail(MAXLIST)
-    character(len=16) :: study, shapes(MAXLIST), schemes(MAXLIST)
+    character(len=16) :: study, shapes(MAXLIST), schemes(MAXLIST), label
     integer :: levels(MAXLIST), quick_levels, u, ios
-    real(wp) :: cfls(MAXLIST), thresholds(MAXLIST), min_order, max_order
-    logical :: quick
+    real(wp) :: cfls(MAXLIST), thresholds(MAXLIST), min_order, max_order, expect_excess, &
+                expect_order_below
+    logical :: quick, expect_abort, expects
     character(len=512) :: msg
     namelist /verify/ benchmark, study, shapes, schemes, levels, cfls, metrics, thresholds, &
-      min_order, max_order, expect_fail, quick_levels, quick
+      min_order, max_order, expect_fail, expect_abort, expect_excess, expect_order_below, label, &
+      quick_levels, quick
     emsg = ''
     spec%file = path
     benchmark = ''; study = 'matrix'; shapes = ''; schemes = ''; levels = 0; cfls = 0.0_wp
     metrics = ''; thresholds = -huge(1.0_wp); min_order = -huge(1.0_wp); max_order = huge(1.0_wp)
-    quick_levels = 2; quick = .true.; expect_fail = ''
+    quick_levels = 2; quick = .true.; expect_fail = ''; label = ''; expect_abort = .false.
+    expect_excess = 0.0_wp; expect_order_below = -huge(1.0_wp)
     open(newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) then
       emsg = path//': cannot open: '//trim(msg); return
@@ -69,7 +81,13 @@ contains
     spec%nshape = count(shapes /= ''); spec%shapes = shapes
     spec%nscheme = count(schemes /= ''); spec%schemes = schemes
     spec%quick_levels = quick_levels; spec%quick = quick; spec%min_order = min_order
-    spec%max_order = max_order; spec%expect_fail = expect_fail
+    spec%max_order = max_order; spec%expect_fail = expect_fail; spec%label = lower(label)
+    spec%expect_abort = expect_abort; spec%expect_excess = expect_excess
+    spec%expect_order_below = expect_order_below
+    expects = any(len_trim(expect_fail) > 0)
+    if (index(trim(label), '/') > 0 .or. index(trim(label), ' ') > 0) then
+      emsg = path//': group &verify: key ''label'': one word without ''/'''; return
+    end if
     if (len_trim(benchmark) == 0) then
       emsg = path//': group &verify: key ''benchmark'': required'; return
     end if
@@ -88,6 +106,10 @@ contains
       if (any(thresholds(1:spec%nmetric) == -huge(1.0_wp))) then
         emsg = path//': group &verify: key ''thresholds'': one per metric ('// &
           str(spec%nmetric)//' expected; -1 = reported only)'; return
+      end if
+      if (expects .and. .not. expect_abort .and. .not. expect_excess > 1.0_wp) then
+        emsg = path//': group &verify: key ''expect_fail'': state the failure''s signature, '// &
+          '''expect_abort = .true.'' or ''expect_excess'' > 1'; return
       end if
     case ('space')
       spec%nlevel = count(levels > 0); spec%levels = levels
@@ -109,9 +131,19 @@ contains
       if (len_trim(spec%metrics(1)) == 0) then
         emsg = path//': group &verify: key ''metrics'': the error measure of the study'; return
       end if
-      if (min_order == -huge(1.0_wp)) then
-        emsg = path//': group &verify: key ''min_order'': required for a convergence study'
-        return
+      ! The assertion of a convergence study: an order it must reach (min_order), or, for a
+      ! demonstration of lost convergence, only a bound it must stay below (max_order).
+      if (min_order == -huge(1.0_wp) .and. max_order == huge(1.0_wp)) then
+        emsg = path//': group &verify: key ''min_order'' (or ''max_order''): required for a '// &
+          'convergence study'; return
+      end if
+      if (min_order /= -huge(1.0_wp) .and. .not. (min_order > 0.0_wp)) then
+        emsg = path//': group &verify: key ''min_order'': a convergence order > 0 (to assert '// &
+          'lost convergence, give only max_order)'; return
+      end if
+      if (expects .and. .not. (expect_order_below > -huge(1.0_wp))) then
+        emsg = path//': group &verify: key ''expect_fail'': state the failure''s signature, '// &
+          '''expect_order_below'''; return
       end if
       if (quick_levels < 2 .or. quick_levels > spec%nlevel) then
         emsg = path//': group &verify: key ''quick_levels'': expected 2..'//str(spec%nlevel); return
