@@ -12,6 +12,10 @@
 !>                         const double *xa, const double *gamma, const double *h,
 !>                         const double *tol0, double *p, double *dp, double *lambda,
 !>                         int *info);
+!>
+!> Fortran 77 callers (`CALL EMPM_LME_BASIS(...)`, default gfortran naming, no module) link to
+!> `empm_lme_basis_`, the same routine under that name in [[empm_f77]]; C callers use the
+!> name above and the header empm.h (docs/embedding.md).
 module empm_lme_legacy
   use, intrinsic :: iso_c_binding, only: c_int, c_double
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
