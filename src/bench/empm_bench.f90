@@ -23,6 +23,7 @@ module empm_bench
   use empm_timer, only: PHASE_COUNT, PHASE_NAMES
   use empm_parallel, only: empm_set_threads, empm_max_threads
   use empm_strings, only: str
+  use empm_files, only: empm_proc_kib
   implicit none
   private
   public :: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json, &
@@ -187,22 +188,8 @@ contains
   !> unavailable (not Linux).
   function empm_peak_rss_bytes() result(bytes)
     integer(int64) :: bytes !! peak RSS [bytes], or −1
-    character(len=256) :: line
-    integer :: u, ios
-    integer(int64) :: kib
-    bytes = -1
-    open(newunit=u, file='/proc/self/status', action='read', status='old', iostat=ios)
-    if (ios /= 0) return
-    do
-      read(u, '(a)', iostat=ios) line
-      if (ios /= 0) exit
-      if (line(1:6) == 'VmHWM:') then
-        read(line(7:), *, iostat=ios) kib
-        if (ios == 0) bytes = 1024_int64 * kib
-        exit
-      end if
-    end do
-    close(u)
+    bytes = empm_proc_kib('/proc/self/status', 'VmHWM:')
+    if (bytes > 0) bytes = 1024_int64 * bytes
   end function empm_peak_rss_bytes
 
   !> One-line JSON object with the keys of docs/performance.md.

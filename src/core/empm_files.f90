@@ -6,7 +6,8 @@ module empm_files
   use empm_error, only: empm_error_t, EMPM_ERR_IO
   implicit none
   private
-  public :: empm_rename, empm_remove, empm_mkdir_p, empm_read_text, empm_physical_memory
+  public :: empm_rename, empm_remove, empm_mkdir_p, empm_read_text, empm_physical_memory, &
+            empm_proc_kib
 
   interface
     function c_rename(old, new) bind(C, name='rename') result(r)
@@ -87,21 +88,30 @@ contains
   !> (not Linux): the limit a case's memory estimate is checked against.
   function empm_physical_memory() result(bytes)
     integer(int64) :: bytes !! physical memory [bytes], or -1
+    bytes = empm_proc_kib('/proc/meminfo', 'MemTotal:')
+    if (bytes > 0) bytes = 1024_int64 * bytes
+  end function empm_physical_memory
+
+  !> The number after `key` on its line of a /proc file in kB (e.g. 'VmHWM:' of
+  !> /proc/self/status), or -1 when the file or the key is missing.
+  function empm_proc_kib(file, key) result(kib)
+    character(len=*), intent(in) :: file !! e.g. '/proc/meminfo'
+    character(len=*), intent(in) :: key  !! e.g. 'MemTotal:'
+    integer(int64) :: kib                !! value [kB], or -1
     character(len=256) :: line
     integer :: u, ios
-    integer(int64) :: kib
-    bytes = -1
-    open(newunit=u, file='/proc/meminfo', action='read', status='old', iostat=ios)
+    kib = -1
+    open(newunit=u, file=file, action='read', status='old', iostat=ios)
     if (ios /= 0) return
     do
       read(u, '(a)', iostat=ios) line
       if (ios /= 0) exit
-      if (line(1:9) == 'MemTotal:') then
-        read(line(10:), *, iostat=ios) kib
-        if (ios == 0) bytes = 1024_int64 * kib
+      if (index(line, key) == 1) then
+        read(line(len(key) + 1:), *, iostat=ios) kib
+        if (ios /= 0) kib = -1
         exit
       end if
     end do
     close(u)
-  end function empm_physical_memory
+  end function empm_proc_kib
 end module empm_files
