@@ -67,7 +67,11 @@ contains
     end if
     call h5_attr(fid, 'empm_version', empm_version(), ierr)
     call h5_attr(fid, 'complete', merge(1, 0, complete), ierr)
-    call h5_attr(fid, 'status', merge('completed', 'stopped  ', complete)//' '//status, ierr)
+    if (complete) then
+      call h5_attr(fid, 'status', 'completed', ierr)
+    else
+      call h5_attr(fid, 'status', trim('stopped: '//status), ierr)
+    end if
     call h5_attr(fid, 'case_file', meta%case_file, ierr)
     call h5_attr(fid, 'case_text', meta%case_text, ierr)
     call h5_attr(fid, 'shape', meta%shape, ierr)

@@ -6,7 +6,8 @@ module empm_verify_suite
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit, int64
   use empm_kinds, only: wp
   use empm_strings, only: str, join
-  use empm_error, only: empm_error_t, EMPM_OK
+  use empm_error, only: empm_error_t, EMPM_OK, EMPM_ERR_IO
+  use empm_files, only: empm_rename
   use empm_json, only: empm_json_t
   use empm_version_info, only: empm_version
   use empm_case, only: empm_case_t, empm_overrides_t
@@ -132,7 +133,8 @@ contains
     call jc%end_array()
     call js%key('convergence'); js%text = js%text//jc%text; js%need_comma = .true.
     call js%end_object()
-    call write_text(outdir//'/summary.json', js%text)
+    call write_text(outdir//'/summary.json', js%text, err)
+    if (err%code /= EMPM_OK) return
     call system_clock(c1)
     write(output_unit, '(a,i0,a,f8.1,a,i0,a)') 'empm verify: ', count(done), ' runs in ', &
       real(c1 - c0, wp) / rate, ' s, ', nfail, ' failed check(s); summary: '//outdir// &
@@ -487,12 +489,32 @@ contains
     end do
   end subroutine expand
 
-  subroutine write_text(path, text)
+  !> Write `text` to `path` (written under a temporary name and renamed, so that a failed
+  !> write never leaves a truncated summary); an I/O failure is an error with the system's
+  !> message.
+  subroutine write_text(path, text, err)
     character(len=*), intent(in) :: path, text
-    integer :: u
-    open(newunit=u, file=path, status='replace', action='write')
-    write(u, '(a)') text
-    close(u)
+    type(empm_error_t), intent(inout) :: err
+    integer :: u, ios, ios2
+    character(len=512) :: msg
+    open(newunit=u, file=path//'.partial', status='replace', action='write', iostat=ios, &
+         iomsg=msg)
+    if (ios == 0) then
+      write(u, '(a)', iostat=ios, iomsg=msg) text
+      close(u, iostat=ios2)
+      if (ios == 0 .and. ios2 /= 0) then
+        ios = ios2; msg = 'closing the file failed'
+      end if
+    end if
+    if (ios == 0) then
+      if (empm_rename(path//'.partial', path) /= 0) then
+        ios = 1; msg = 'cannot rename '//path//'.partial'
+      end if
+    end if
+    if (ios /= 0) then
+      err%code = EMPM_ERR_IO
+      err%message = path//': cannot write the summary: '//trim(msg)
+    end if
   end subroutine write_text
 
   !> Current local time as ISO 8601 (e.g. 2026-11-21T05:19:14+00:00).
