@@ -209,7 +209,9 @@ contains
     real(wp), intent(in) :: m(:)                             !! particle masses
     real(wp), intent(inout), contiguous :: mass(:)           !! nodal masses (accumulated)
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    call p2g_drive(OP_MASS, basis, ws, m=m, mass=mass)
+    real(wp) :: none1(0), none2(0, 0)
+    call p2g_drive(OP_MASS, basis, ws, m, none2, 0.0_wp, none2, none1, none2, none1, none2, &
+                   .false., mass, none2)
   end subroutine p2g_mass
 
   !> Mass-weighted transfer q_I += Σ_p N_Ip m_p (u_p + c·w_p), e.g. momentum (c = 0) or the
@@ -222,7 +224,9 @@ contains
     real(wp), intent(in), contiguous :: w(:,:)               !! second particle vectors (ndim, np)
     real(wp), intent(inout), contiguous :: q(:,:)            !! nodal vectors (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    call p2g_drive(OP_WEIGHTED, basis, ws, m=m, u=u, c=c, w=w, q=q)
+    real(wp) :: none1(0), none2(0, 0)
+    call p2g_drive(OP_WEIGHTED, basis, ws, m, u, c, w, none1, none2, none1, none2, .false., &
+                   none1, q)
   end subroutine p2g_weighted
 
   !> Lumped mass and a mass-weighted vector in one pass over the particles:
@@ -237,7 +241,9 @@ contains
     real(wp), intent(inout), contiguous :: mass(:)           !! nodal masses (accumulated)
     real(wp), intent(inout), contiguous :: q(:,:)            !! nodal vectors (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    call p2g_drive(OP_MASS_MOMENTUM, basis, ws, m=m, u=u, c=c, w=w, mass=mass, q=q)
+    real(wp) :: none1(0), none2(0, 0)
+    call p2g_drive(OP_MASS_MOMENTUM, basis, ws, m, u, c, w, none1, none2, none1, none2, &
+                   .false., mass, q)
   end subroutine p2g_mass_momentum
 
   !> Internal force f_I −= Σ_p V_p σ_p ∇N_Ip (paper eq. 16), σ in Voigt order.
@@ -247,7 +253,9 @@ contains
     real(wp), intent(in), contiguous :: stress(:,:)          !! Cauchy stress (6, np)
     real(wp), intent(inout), contiguous :: f(:,:)            !! nodal forces (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    call p2g_drive(OP_INTERNAL_FORCE, basis, ws, vol=vol, stress=stress, q=f)
+    real(wp) :: none1(0), none2(0, 0)
+    call p2g_drive(OP_INTERNAL_FORCE, basis, ws, none1, none2, 0.0_wp, none2, vol, stress, none1, &
+                   none2, .false., none1, f)
   end subroutine p2g_internal_force
 
   !> External body force f_I += Σ_p N_Ip m_p (g + b_p) (paper eq. 17 without tractions).
@@ -259,31 +267,34 @@ contains
     logical, intent(in) :: use_b                             !! whether `b` holds data
     real(wp), intent(inout), contiguous :: f(:,:)            !! nodal forces (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
+    real(wp) :: none1(0), none2(0, 0)
     ! Nothing to add: skip the pass (adding zeros leaves f unchanged bit for bit).
     if (.not. use_b .and. all(g == 0.0_wp)) return
-    call p2g_drive(OP_BODY_FORCE, basis, ws, m=m, g=g, b=b, use_b=use_b, q=f)
+    call p2g_drive(OP_BODY_FORCE, basis, ws, m, none2, 0.0_wp, none2, none1, none2, g, b, use_b, &
+                   none1, f)
   end subroutine p2g_body_force
 
   !> The P2G skeleton of every `p2g_*` above: accumulate the sums `op` selects into `mass`
   !> and/or `q`. Serial over all particles without a threaded workspace; otherwise each task
   !> of each phase (module comment) sends its particle range to the target (dst = 0) or to its
-  !> chunk's buffers, and the buffers are reduced into the targets present. Only the
-  !> arguments `op` reads need be present.
+  !> chunk's buffers, and the buffers are reduced into the targets `op` writes. The arguments
+  !> `op` does not read are zero-size arrays (not absent optional ones: gfortran forms the
+  !> descriptor of an absent array argument from a null pointer, which UBSan rightly reports).
   subroutine p2g_drive(op, basis, ws, m, u, c, w, vol, stress, g, b, use_b, mass, q)
     integer, intent(in) :: op                                       !! OP_* selector
     type(empm_basis_t), intent(in) :: basis                         !! shape functions at the particles
     type(empm_p2g_work_t), intent(inout), optional :: ws            !! threaded-P2G workspace
-    real(wp), intent(in), optional :: m(:)                          !! particle masses
-    real(wp), intent(in), optional, contiguous :: u(:,:)            !! particle vectors (ndim, np)
-    real(wp), intent(in), optional :: c                             !! scale of `w` (0 to ignore it)
-    real(wp), intent(in), optional, contiguous :: w(:,:)            !! second particle vectors (ndim, np)
-    real(wp), intent(in), optional :: vol(:)                        !! particle volumes
-    real(wp), intent(in), optional, contiguous :: stress(:,:)       !! Cauchy stress (6, np)
-    real(wp), intent(in), optional :: g(:)                          !! uniform acceleration (ndim)
-    real(wp), intent(in), optional :: b(:,:)                        !! body force per unit mass (ndim, np)
-    logical, intent(in), optional :: use_b                          !! whether `b` holds data
-    real(wp), intent(inout), optional, contiguous :: mass(:)        !! nodal scalars (accumulated)
-    real(wp), intent(inout), optional, contiguous :: q(:,:)         !! nodal vectors (ndim, nnode), accumulated
+    real(wp), intent(in) :: m(:)                          !! particle masses
+    real(wp), intent(in), contiguous :: u(:,:)            !! particle vectors (ndim, np)
+    real(wp), intent(in) :: c                             !! scale of `w` (0 to ignore it)
+    real(wp), intent(in), contiguous :: w(:,:)            !! second particle vectors (ndim, np)
+    real(wp), intent(in) :: vol(:)                        !! particle volumes
+    real(wp), intent(in), contiguous :: stress(:,:)       !! Cauchy stress (6, np)
+    real(wp), intent(in) :: g(:)                          !! uniform acceleration (ndim)
+    real(wp), intent(in) :: b(:,:)                        !! body force per unit mass (ndim, np)
+    logical, intent(in) :: use_b                          !! whether `b` holds data
+    real(wp), intent(inout), contiguous :: mass(:)        !! nodal scalars (accumulated)
+    real(wp), intent(inout), contiguous :: q(:,:)         !! nodal vectors (ndim, nnode), accumulated
     integer :: it, p0, p1, ph, dst
     if (.not. threaded(ws)) then
       call p2g_range(op, basis, 1, basis%np, m, u, c, w, vol, stress, g, b, use_b, mass, q)
@@ -304,8 +315,8 @@ contains
       end do
       !$omp end do
     end do
-    if (present(mass)) call reduce_scalar(ws, mass)
-    if (present(q)) call reduce_vec(ws, q)
+    if (op == OP_MASS .or. op == OP_MASS_MOMENTUM) call reduce_scalar(ws, mass)
+    if (op /= OP_MASS) call reduce_vec(ws, q)
     !$omp end parallel
   end subroutine p2g_drive
 
@@ -316,17 +327,17 @@ contains
     type(empm_basis_t), intent(in) :: basis                         !! shape functions at the particles
     integer, intent(in) :: p0                                       !! first particle
     integer, intent(in) :: p1                                       !! last particle
-    real(wp), intent(in), optional :: m(:)                          !! particle masses
-    real(wp), intent(in), optional, contiguous :: u(:,:)            !! particle vectors (ndim, np)
-    real(wp), intent(in), optional :: c                             !! scale of `w` (0 to ignore it)
-    real(wp), intent(in), optional, contiguous :: w(:,:)            !! second particle vectors (ndim, np)
-    real(wp), intent(in), optional :: vol(:)                        !! particle volumes
-    real(wp), intent(in), optional, contiguous :: stress(:,:)       !! Cauchy stress (6, np)
-    real(wp), intent(in), optional :: g(:)                          !! uniform acceleration (ndim)
-    real(wp), intent(in), optional :: b(:,:)                        !! body force per unit mass (ndim, np)
-    logical, intent(in), optional :: use_b                          !! whether `b` holds data
-    real(wp), intent(inout), optional, contiguous :: mass(:)        !! nodal scalars (accumulated)
-    real(wp), intent(inout), optional, contiguous :: q(:,:)         !! nodal vectors (ndim, nnode), accumulated
+    real(wp), intent(in) :: m(:)                          !! particle masses
+    real(wp), intent(in), contiguous :: u(:,:)            !! particle vectors (ndim, np)
+    real(wp), intent(in) :: c                             !! scale of `w` (0 to ignore it)
+    real(wp), intent(in), contiguous :: w(:,:)            !! second particle vectors (ndim, np)
+    real(wp), intent(in) :: vol(:)                        !! particle volumes
+    real(wp), intent(in), contiguous :: stress(:,:)       !! Cauchy stress (6, np)
+    real(wp), intent(in) :: g(:)                          !! uniform acceleration (ndim)
+    real(wp), intent(in) :: b(:,:)                        !! body force per unit mass (ndim, np)
+    logical, intent(in) :: use_b                          !! whether `b` holds data
+    real(wp), intent(inout), contiguous :: mass(:)        !! nodal scalars (accumulated)
+    real(wp), intent(inout), contiguous :: q(:,:)         !! nodal vectors (ndim, nnode), accumulated
     select case (op)
     case (OP_MASS)
       call mass_range(basis, m, p0, p1, mass)
