@@ -16,8 +16,8 @@ module empm_input
   use empm_error, only: empm_error_t, empm_raise_error, EMPM_ERR_INPUT, EMPM_OK
   use empm_strings, only: str, str_short
   use empm_files, only: empm_read_text, empm_physical_memory
-  use empm_params, only: empm_param_t, empm_param, empm_params_markdown, PARAM_REAL, PARAM_INT, &
-                         PARAM_STR, PARAM_LOGICAL
+  use empm_params, only: empm_param_t, empm_param, empm_params_markdown, empm_param_names, &
+                         PARAM_REAL, PARAM_INT, PARAM_STR, PARAM_LOGICAL
   use empm_namelist, only: empm_group_t, empm_parse_namelist
   use empm_case, only: empm_case_t, empm_overrides_t
   use empm_model, only: empm_material_slot_t
@@ -281,19 +281,8 @@ contains
     character(len=*), intent(in) :: path, name
     type(empm_error_t), intent(inout) :: e
     call e%set(EMPM_ERR_INPUT, 'missing required group &'//name//' (keys: '// &
-      key_list(empm_input_group_params(name))//')', file=path)
+      empm_param_names(empm_input_group_params(name))//')', file=path)
   end subroutine missing_group
-
-  pure function key_list(p) result(s)
-    type(empm_param_t), intent(in) :: p(:)
-    character(len=:), allocatable :: s
-    integer :: i
-    s = ''
-    do i = 1, size(p)
-      if (i > 1) s = s//', '
-      s = s//p(i)%name
-    end do
-  end function key_list
 
   ! ---- groups -----------------------------------------------------------------------------
 
