@@ -15,6 +15,7 @@ module empm_integrator
                            nodal_divide_by_mass, g2p_value, &
                            velocity_gradient, empm_p2g_work_t
   use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID
+  use empm_material, only: empm_material_ctx_t
   use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds
   implicit none
   private
@@ -209,6 +210,9 @@ contains
     type(empm_step_status_t), intent(inout) :: stat !! set on failure
     real(wp) :: Lb(3, 3, STRESS_BLOCK)
     integer :: r, i0, i1, info, im, n, nc, c, a, b, q0, q1, bad, p
+    type(empm_material_ctx_t) :: ctx
+    ctx%t = model%t; ctx%step = model%step + 1; ctx%ndim = model%grid%ndim
+    ctx%h = minval(model%grid%h(1:model%grid%ndim))
     do r = 1, size(model%run_first)
       i0 = model%run_first(r); i1 = model%run_last(r)
       im = model%pts%mat(i0)
@@ -217,7 +221,7 @@ contains
       ! The first failing particle of the run, whichever block it is in.
       bad = huge(1)
       !$omp parallel do default(none) schedule(static, 1) shared(model, vel, dt, i0, im, n, nc) &
-      !$omp& private(a, b, q0, q1, p, Lb, info) reduction(min: bad) if(nc > 1)
+      !$omp& private(a, b, q0, q1, p, Lb, info) firstprivate(ctx) reduction(min: bad) if(nc > 1)
       do c = 0, nc - 1
         call empm_chunk_bounds(n, nc, c, a, b)
         a = a + i0 - 1; b = b + i0 - 1
@@ -225,9 +229,10 @@ contains
         do q0 = a, b, STRESS_BLOCK
           q1 = min(b, q0 + STRESS_BLOCK - 1)
           call velocity_gradient(model%basis, vel, q0, q1, Lb)
+          ctx%first = q0
           call model%mats(im)%model%update(dt, Lb(:, :, 1:q1 - q0 + 1), model%pts%F(:, :, q0:q1), &
             model%pts%strain(:, q0:q1), model%pts%stress(:, q0:q1), model%pts%state(:, q0:q1), &
-            model%pts%rho(q0:q1), info)
+            model%pts%rho(q0:q1), ctx, info)
           if (info /= 0) bad = min(bad, q0 + info - 1)
           do p = q0, q1
             model%pts%vol(p) = model%pts%m(p) / model%pts%rho(p)

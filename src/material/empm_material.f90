@@ -24,9 +24,20 @@ module empm_material
   use empm_namelist, only: empm_group_t
   implicit none
   private
-  public :: empm_material_t, STATE_NAME_LEN
+  public :: empm_material_t, empm_material_ctx_t, STATE_NAME_LEN
 
   integer, parameter :: STATE_NAME_LEN = 32 !! length of the names given by `state_names`
+
+  !> Where and when a batch is updated: what a model may need besides the kinematics (a user
+  !> subroutine's element number, time and increment number, a regularisation length).
+  type :: empm_material_ctx_t
+    real(wp) :: t = 0.0_wp  !! time at the start of the step [s]
+    integer :: step = 1     !! number of the step being taken (1 for the first)
+    integer :: first = 1    !! particle index of the batch's first particle (1-based, in the
+                            !! particle arrays)
+    integer :: ndim = 3     !! spatial dimension of the model (1, 2 or 3)
+    real(wp) :: h = 0.0_wp  !! smallest grid spacing [m] (0 when there is no grid)
+  end type empm_material_ctx_t
 
   !> Abstract material.
   type, abstract, extends(empm_family_t) :: empm_material_t
@@ -49,8 +60,10 @@ module empm_material
     !> variables and the density (rho is updated as the model's kinematics dictate; see each
     !> model). The arrays are contiguous (the particle arrays' sections for a run of particles
     !> are; anything else is copied in and out by the compiler).
-    pure subroutine update_iface(self, dt, L, F, strain, stress, state, rho, info)
-      import :: empm_material_t, wp
+    !> Not required to be pure (a user subroutine behind an adapter is not), but it must be
+    !> thread-safe: batches of one material are updated concurrently with OpenMP.
+    subroutine update_iface(self, dt, L, F, strain, stress, state, rho, ctx, info)
+      import :: empm_material_t, empm_material_ctx_t, wp
       class(empm_material_t), intent(in) :: self  !! material
       real(wp), intent(in) :: dt                  !! time step [s]
       real(wp), intent(in), contiguous :: L(:,:,:)         !! velocity gradient (3,3,n) [1/s]
@@ -60,6 +73,7 @@ module empm_material
       real(wp), intent(inout), contiguous :: state(:,:)    !! state variables (nstate_max,n):
                                                            !! the model owns rows 1..nstate
       real(wp), intent(inout), contiguous :: rho(:)        !! density (n) [kg/m³]
+      type(empm_material_ctx_t), intent(in) :: ctx         !! time, step, batch position
       integer, intent(out) :: info                !! 0 ok; k > 0: particle k of the batch failed
     end subroutine update_iface
 

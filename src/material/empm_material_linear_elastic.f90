@@ -1,7 +1,10 @@
-!> Isotropic linear elasticity, small-strain hypoelastic update (paper eqs. 2–4, 18–19).
+!> Isotropic linear elasticity, hypoelastic update (paper eqs. 2–4, 18–19), objective by default.
 !>
 !> Each step: Δε = Δt·sym(L), ε ← ε + Δε, σ ← σ + D:Δε with the isotropic D (Lamé λ, μ),
-!> ρ ← ρ/(1 + tr Δε) (eq. 19). 1D uniaxial strain and 2D plane strain need no special case:
+!> ρ ← ρ/(1 + tr Δε) (eq. 19). With `rate = 'jaumann'` (the default) the stress is first
+!> rotated with the spin of the step (σ ← σ + Δt(Wσ − σW), [[jaumann_rotate]]), so that a body
+!> in rigid rotation carries its stress with it; `rate = 'small_strain'` is the paper's update,
+!> which omits the rotation. The two agree wherever W = 0 (always in 1D). 1D uniaxial strain and 2D plane strain need no special case:
 !> the velocity gradient is zero in the unused directions, so the lateral stresses come out
 !> as λ·tr Δε by themselves. The small-strain model does not track the deformation gradient: F
 !> is left as it is (identity) — updating it cost a third of the stress phase's memory traffic and
@@ -13,14 +16,15 @@
 module empm_material_linear_elastic
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t
-  use empm_params, only: empm_param_t, empm_param, PARAM_REAL
+  use empm_params, only: empm_param_t, empm_param, PARAM_REAL, PARAM_STR
   use empm_namelist, only: empm_group_t
-  use empm_material, only: empm_material_t
+  use empm_material, only: empm_material_t, empm_material_ctx_t
   use empm_tensor, only: voigt_ddot
+  use empm_plasticity, only: jaumann_rotate
   implicit none
   private
   public :: empm_linear_elastic_t, empm_elastic_check, empm_lame
-  public :: empm_elastic_params, empm_elastic_read
+  public :: empm_elastic_params, empm_elastic_read, empm_rate_param, empm_rate_read
   public :: MAT_OK, MAT_BAD_E, MAT_BAD_NU, MAT_BAD_RHO0
 
   integer, parameter :: MAT_OK = 0       !! parameters valid / update succeeded
@@ -34,6 +38,7 @@ module empm_material_linear_elastic
     real(wp) :: nu = 0.0_wp     !! Poisson's ratio [-]
     real(wp) :: lambda = 0.0_wp !! first Lamé parameter [Pa]
     real(wp) :: mu = 0.0_wp     !! shear modulus [Pa]
+    logical :: jaumann = .true. !! rotate the stress with the spin (objective rate)
   contains
     procedure :: init => le_init
     procedure :: configure => le_configure
@@ -60,6 +65,26 @@ contains
       empm_param('nu', PARAM_REAL, '-', "Poisson's ratio", default='0', lo=-1.0_wp, &
         hi=0.5_wp, lo_open=.true., hi_open=.true.)]
   end function empm_elastic_params
+
+  !> The `rate` key of the rate-form models: 'jaumann' (objective, the default) or
+  !> 'small_strain' (no rotation, the paper's update).
+  pure function empm_rate_param() result(p)
+    type(empm_param_t) :: p !! declaration
+    p = empm_param('rate', PARAM_STR, '-', "stress rate: 'jaumann' (objective: the stress " &
+      //"rotates with the spin of the velocity gradient) or 'small_strain' (the paper's update, " &
+      //'without rotation)', default="'jaumann'", choices='jaumann small_strain')
+  end function empm_rate_param
+
+  !> Read the `rate` key ([[empm_rate_param]]): true for 'jaumann'.
+  subroutine empm_rate_read(group, jaumann, err)
+    type(empm_group_t), intent(inout) :: group !! the `&material` group
+    logical, intent(out) :: jaumann            !! objective (Jaumann) rate
+    type(empm_error_t), intent(inout) :: err   !! set on an invalid value
+    character(len=:), allocatable :: rate
+    rate = 'jaumann'
+    call group%get(empm_rate_param(), rate, err)
+    jaumann = rate == 'jaumann'
+  end subroutine empm_rate_read
 
   !> Read and validate `density`, `E` and `nu` ([[empm_elastic_params]]) from a `&material`
   !> group; `err` names the key of the first missing or invalid one. The bounds are those of
@@ -139,6 +164,7 @@ contains
     real(wp) :: E, nu, rho0
     integer :: info
     call empm_elastic_read(group, E, nu, rho0, err)
+    call empm_rate_read(group, self%jaumann, err)
     if (err%code /= 0) return
     call self%init(E, nu, rho0, info)
     if (info /= MAT_OK) call group%fail(err, '', 'invalid elastic constants') ! checked above
@@ -160,18 +186,18 @@ contains
     s = 'isotropic linear elasticity, small-strain hypoelastic update (the paper''s)'
   end function le_summary
 
-  !> Parameters: `density`, `E`, `nu` ([[empm_elastic_params]]).
+  !> Parameters: `density`, `E`, `nu` ([[empm_elastic_params]]) and `rate`.
   pure function le_params(self) result(p)
     class(empm_linear_elastic_t), intent(in) :: self !! material
     type(empm_param_t), allocatable :: p(:)          !! declarations
     associate (unused_ => self); end associate
-    p = empm_elastic_params()
+    p = [empm_elastic_params(), empm_rate_param()]
   end function le_params
 
   !> Hypoelastic update of `n = size(rho)` particles (see the module notes).
   !> `info = k > 0`: 1 + tr Δε <= 0 at particle k (the first such), whose state is left
   !> unchanged (the other particles are updated); `info = -1`: array extents disagree with n.
-  pure subroutine le_update(self, dt, L, F, strain, stress, state, rho, info)
+  pure subroutine le_update(self, dt, L, F, strain, stress, state, rho, ctx, info)
     class(empm_linear_elastic_t), intent(in) :: self !! material
     real(wp), intent(in) :: dt                       !! time step [s]
     real(wp), intent(in), contiguous :: L(:,:,:)           !! velocity gradient (3,3,n) [1/s]
@@ -180,10 +206,11 @@ contains
     real(wp), intent(inout), contiguous :: stress(:,:)     !! Cauchy stress, Voigt (6,n) [Pa]
     real(wp), intent(inout), contiguous :: state(:,:)      !! state variables, none used
     real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
+    type(empm_material_ctx_t), intent(in) :: ctx     !! unused
     integer, intent(out) :: info                     !! 0 ok; k > 0 particle k failed; −1 shapes
     real(wp) :: de(6), tr
     integer :: p, n
-    associate (unused_ => state); end associate
+    associate (unused_ => state, unused2_ => ctx); end associate
     info = 0
     n = size(rho)
     if (size(L, 3) /= n .or. size(F, 3) /= n .or. size(strain, 2) /= n &
@@ -205,6 +232,7 @@ contains
         cycle
       end if
       strain(:,p) = strain(:,p) + de
+      if (self%jaumann) call jaumann_rotate(dt, L(:,:,p), stress(:,p))
       stress(1:3,p) = stress(1:3,p) + self%lambda * tr + 2.0_wp * self%mu * de(1:3)
       stress(4:6,p) = stress(4:6,p) + 2.0_wp * self%mu * de(4:6)
       rho(p) = rho(p) / (1.0_wp + tr)

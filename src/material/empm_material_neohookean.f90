@@ -15,7 +15,7 @@ module empm_material_neohookean
   use empm_error, only: empm_error_t
   use empm_params, only: empm_param_t
   use empm_namelist, only: empm_group_t
-  use empm_material, only: empm_material_t
+  use empm_material, only: empm_material_t, empm_material_ctx_t
   use empm_material_linear_elastic, only: empm_elastic_check, empm_lame, empm_elastic_params, &
                                           empm_elastic_read, MAT_OK
   use empm_tensor, only: identity3, det3, mat_to_voigt, advance_f
@@ -123,7 +123,7 @@ contains
   !> `info = k > 0`: det F <= 0 after the step at particle k (the first such), or already
   !> before it; that particle's state is left unchanged, the others are updated.
   !> `info = −1`: array extents disagree with n.
-  pure subroutine nh_update(self, dt, L, F, strain, stress, state, rho, info)
+  pure subroutine nh_update(self, dt, L, F, strain, stress, state, rho, ctx, info)
     class(empm_neohookean_t), intent(in) :: self !! material
     real(wp), intent(in) :: dt                   !! time step [s]
     real(wp), intent(in), contiguous :: L(:,:,:)           !! velocity gradient (3,3,n) [1/s]
@@ -132,10 +132,11 @@ contains
     real(wp), intent(inout), contiguous :: stress(:,:)     !! Cauchy stress, Voigt (6,n) [Pa]
     real(wp), intent(inout), contiguous :: state(:,:)      !! state variables, none used
     real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
+    type(empm_material_ctx_t), intent(in) :: ctx !! unused
     integer, intent(out) :: info                 !! 0 ok; k > 0 particle k failed; −1 shapes
     real(wp) :: eye(3,3), Fn(3,3), J0, J1
     integer :: p, n
-    associate (unused_ => state); end associate
+    associate (unused_ => state, unused2_ => ctx); end associate
     info = 0
     n = size(rho)
     if (size(L, 3) /= n .or. size(F, 3) /= n .or. size(strain, 2) /= n &
