@@ -52,6 +52,7 @@ module empm_material
     procedure :: state_names => material_state_names
     procedure :: init_state => material_init_state
     procedure :: failure_text => material_failure_text
+    procedure :: max_wave_speed => material_max_wave_speed
   end type empm_material_t
 
   abstract interface
@@ -142,6 +143,19 @@ contains
     associate (unused_ => self); end associate
     state = 0.0_wp
   end subroutine material_init_state
+
+  !> Largest P-wave speed over a run of particles of this material, for the CFL time step
+  !> (evaluated every step). The default is `wave_speed` at the smallest density (wave speeds
+  !> do not increase with density); a model whose stiffness depends on the stress or the
+  !> state (pressure-dependent elasticity) overrides it.
+  pure real(wp) function material_max_wave_speed(self, rho, stress, state) result(c)
+    class(empm_material_t), intent(in) :: self !! material
+    real(wp), intent(in) :: rho(:)             !! densities of the run (n) [kg/m³]
+    real(wp), intent(in) :: stress(:,:)        !! Cauchy stresses (6,n) [Pa]
+    real(wp), intent(in) :: state(:,:)         !! state variables (nstate_max,n)
+    associate (unused_ => stress, unused2_ => state); end associate
+    c = self%wave_speed(minval(rho))
+  end function material_max_wave_speed
 
   !> Why `update` reported a particle as failed (`info = k > 0`), for the run's error message.
   !> The default is the kinematic failure every model shares; a model that can fail otherwise

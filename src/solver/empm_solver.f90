@@ -66,8 +66,7 @@ contains
   end function empm_run_params
 
   !> Largest stable time step h_min / c_max, with c_max the largest P-wave speed over the
-  !> particles (wave speeds are non-increasing in density, so each material run is evaluated
-  !> once, at its smallest density).
+  !> particles (each material run asked once, `max_wave_speed`).
   function empm_stable_dt(model) result(dt)
     type(empm_model_t), intent(in) :: model !! simulation state
     real(wp) :: dt                          !! critical time step [s]
@@ -76,7 +75,8 @@ contains
     cmax = 0.0_wp
     do r = 1, size(model%run_first)
       i0 = model%run_first(r); i1 = model%run_last(r)
-      c = model%mats(model%pts%mat(i0))%model%wave_speed(minval(model%pts%rho(i0:i1)))
+      c = model%mats(model%pts%mat(i0))%model%max_wave_speed(model%pts%rho(i0:i1), &
+        model%pts%stress(:, i0:i1), model%pts%state(:, i0:i1))
       cmax = max(cmax, c)
     end do
     dt = model%grid%hmin() / cmax
