@@ -247,6 +247,86 @@ def disks_section(s):
             f"![Colliding disks energy]({savefig(fig, 'colliding_disks_energy.png')})", ""]
 
 
+def sp_array(f, name):
+    """A (k, n+1) history written by Fortran as (k, 0:n): rows are the components."""
+    a = f[name][:]
+    return a.T if a.ndim == 2 and a.shape[1] in (6,) and a.shape[0] != 6 else a
+
+
+def stress_point_section(s):
+    """Stress-point element tests against closed forms, and the objectivity study."""
+    cases = [c for c in s["cases"] if c["id"].split("/")[0] in ("stress_point", "objectivity")]
+    _, conv = by_bench(s, "objectivity")
+    if not cases:
+        return []
+    lines = ["## Stress-point tests and objectivity", "",
+             "One material point driven through element-test paths by prescribed velocity "
+             "gradients, with mixed control of the lateral or normal stress "
+             "(docs/benchmarks.md, docs/verification.md). Metrics: `closed_form_error` "
+             "(relative), `yield_violation` (largest relative violation of the yield condition "
+             "after any update), `split_dependence` (stresses with every increment split into "
+             "10, relative), `control_residual` (held stress components, relative).", ""]
+    groups = {"triaxial": [], "simple_shear": [], "mcc": []}
+    for c in cases:
+        if c["id"].startswith("objectivity/"):
+            continue
+        with h5(c["output"]) as f:
+            path = f.attrs["path"].decode() if isinstance(f.attrs["path"], bytes) else str(f.attrs["path"])
+            path = path.strip()
+            key = ("triaxial" if path.startswith("triaxial") else
+                   "simple_shear" if path == "simple_shear" else "mcc")
+            groups[key].append((c, path, sp_array(f, "stress"), sp_array(f, "strain"),
+                                dict((k, np.ravel(f.attrs[k])[0]) for k in f.attrs
+                                     if k not in ("path", "model"))))
+    if groups["triaxial"]:
+        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        for c, path, st, ep, at in groups["triaxial"]:
+            m = st[:3].mean(axis=0)
+            q = np.sqrt(1.5 * ((st[:3] - m) ** 2).sum(axis=0) + 3 * (st[3:] ** 2).sum(axis=0))
+            line, = ax.plot(100 * np.abs(ep[0]), q / 1e3, lw=1.2, label=c["id"].split("/")[1])
+            ax.axhline(at["exact_value"] / 1e3, color=line.get_color(), ls=":", lw=1)
+        ax.set_xlabel("axial strain |ε_a| [%]"); ax.set_ylabel("q [kPa]"); ax.grid(alpha=0.3)
+        ax.set_title("Drained triaxial: q vs axial strain (dotted: closed-form peak)")
+        ax.legend(fontsize=7)
+        lines += [f"![triaxial]({savefig(fig, 'stress_point_triaxial.png')})", ""]
+    if groups["simple_shear"]:
+        fig, ax = plt.subplots(figsize=(6.4, 4.4))
+        for c, path, st, ep, at in groups["simple_shear"]:
+            line, = ax.plot(100 * 2 * ep[5], st[5] / np.maximum(-st[1], 1e-300), lw=1.2,
+                            label=c["id"].split("/")[1])
+            ax.axhline(at["exact_value"], color=line.get_color(), ls=":", lw=1)
+        ax.set_xlabel("shear strain γ [%]"); ax.set_ylabel("τ/σ'n"); ax.grid(alpha=0.3)
+        ax.set_title("Plane-strain simple shear (dotted: Davis limit ratio)")
+        ax.legend(fontsize=7)
+        lines += [f"![simple shear]({savefig(fig, 'stress_point_simple_shear.png')})", ""]
+    if groups["mcc"]:
+        fig, ax = plt.subplots(figsize=(6.4, 4.8))
+        for c, path, st, ep, at in groups["mcc"]:
+            p = -st[:3].mean(axis=0)
+            m = -p
+            q = np.sqrt(1.5 * ((st[:3] - m) ** 2).sum(axis=0) + 3 * (st[3:] ** 2).sum(axis=0))
+            line, = ax.plot(p / 1e3, q / 1e3, lw=1.2, label=c["id"].split("/")[1])
+            M, p0 = at["M"], p[0]
+            if path == "mcc_drained":
+                pe = 3 * p0 / (3 - M)
+                ax.plot([p0 / 1e3, pe / 1e3], [0, M * pe / 1e3], ":", color=line.get_color(),
+                        lw=1)
+            else:
+                eta = np.linspace(0, M, 200)
+                pc0, L = at.get("pc0", p0), at["Lambda"]
+                pe = p0 * ((pc0 / p0) * M ** 2 / (M ** 2 + eta ** 2)) ** L
+                ax.plot(pe / 1e3, eta * pe / 1e3, ":", color=line.get_color(), lw=1)
+            pp = np.linspace(0, p.max() * 1.1, 10)
+            ax.plot(pp / 1e3, M * pp / 1e3, "k--", lw=0.6)
+        ax.set_xlabel("p' [kPa]"); ax.set_ylabel("q [kPa]"); ax.grid(alpha=0.3)
+        ax.set_title("Modified Cam-Clay: q–p' paths (dotted: closed forms; dashed: CSL)")
+        ax.legend(fontsize=7)
+        lines += [f"![MCC]({savefig(fig, 'stress_point_mcc.png')})", ""]
+    lines += convergence_section(conv, "objectivity.png",
+                                 "Objectivity: rigid rotation by 90°, error vs Δt")
+    return lines
+
+
 def main():
     summary_path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(HERE, "summary.json")
     with open(summary_path) as f:
@@ -281,6 +361,7 @@ def main():
             lines += convergence_section(time, f"{bench}_time.png", f"{title}: time")
     lines += andersen_section(s)
     lines += disks_section(s)
+    lines += stress_point_section(s)
     extra = [("integrators/stability.png", "Integrator stability: spectral radius, damping, "
               "period error (docs/integrators.md)"),
              ("integrators/energy.png", "Energy histories per integrator"),

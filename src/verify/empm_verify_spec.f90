@@ -15,11 +15,12 @@ module empm_verify_spec
   type :: empm_verify_spec_t
     character(len=:), allocatable :: file        !! case file
     character(len=32) :: benchmark = ''          !! benchmark id (dyka, vibrating_bar, ...)
-    character(len=16) :: study = 'matrix'        !! 'matrix', 'space' or 'time'
+    character(len=16) :: study = 'matrix'        !! 'matrix', 'space', 'time' or 'stress_point'
     integer :: nshape = 0, nscheme = 0, nlevel = 0, nmetric = 0
     character(len=16) :: shapes(MAXLIST) = ''    !! shape identifiers
     character(len=16) :: schemes(MAXLIST) = ''   !! scheme names
-    integer :: levels(MAXLIST) = 0               !! space study: refinement factors
+    integer :: levels(MAXLIST) = 0               !! space study: refinement factors;
+                                                 !! stress_point: multipliers of the increments
     real(wp) :: cfls(MAXLIST) = 0.0_wp           !! time study: Courant numbers
     character(len=32) :: metrics(MAXLIST) = ''   !! matrix study: metric names
     real(wp) :: thresholds(MAXLIST) = 0.0_wp     !! matrix study: upper bounds
@@ -27,7 +28,7 @@ module empm_verify_spec
     real(wp) :: max_order = huge(1.0_wp)         !! convergence study: order must stay below
                                                  !! (to assert a known loss of convergence)
     character(len=64) :: expect_fail(MAXLIST) = '' !! run-id patterns expected to fail a check
-    character(len=16) :: label = ''              !! variant of the study, part of its ids
+    character(len=32) :: label = ''              !! variant of the study, part of its ids
     !> The signature an expected failure must show (a known failure that stops showing it, or
     !> that fails differently, fails its check): a matrix run either aborts (`expect_abort`) or
     !> completes with an asserted metric above `expect_excess` times its threshold; a
@@ -51,7 +52,8 @@ contains
       'expect_order_below, label, quick_levels, quick'
     character(len=32) :: benchmark, metrics(MAXLIST)
     character(len=64) :: expect_fail(MAXLIST)
-    character(len=16) :: study, shapes(MAXLIST), schemes(MAXLIST), label
+    character(len=16) :: study, shapes(MAXLIST), schemes(MAXLIST)
+    character(len=32) :: label
     integer :: levels(MAXLIST), quick_levels, u, ios
     real(wp) :: cfls(MAXLIST), thresholds(MAXLIST), min_order, max_order, expect_excess, &
                 expect_order_below
@@ -91,6 +93,48 @@ contains
     if (len_trim(benchmark) == 0) then
       emsg = path//': group &verify: key ''benchmark'': required'; return
     end if
+    if (spec%study == 'stress_point') then
+      ! A stress-point study (a material point, no grid: no shapes or schemes): metrics with
+      ! thresholds as in a matrix study, one run, or with `levels` (increment multipliers, at
+      ! least two) also a convergence study in the increment, asserting an order.
+      if (len_trim(label) == 0) then
+        emsg = path//': group &verify: key ''label'': required for study = ''stress_point'' '// &
+          '(the run id is benchmark/label)'; return
+      end if
+      spec%nmetric = count(metrics /= '')
+      spec%metrics = metrics; spec%thresholds = thresholds
+      if (spec%nmetric == 0) then
+        emsg = path//': group &verify: key ''metrics'': at least one for study = ''stress_point'''
+        return
+      end if
+      if (any(thresholds(1:spec%nmetric) == -huge(1.0_wp))) then
+        emsg = path//': group &verify: key ''thresholds'': one per metric ('// &
+          str(spec%nmetric)//' expected; -1 = reported only)'; return
+      end if
+      if (expects) then
+        emsg = path//': group &verify: key ''expect_fail'': not supported for study = '// &
+          '''stress_point'''; return
+      end if
+      spec%nlevel = count(levels > 0); spec%levels = levels
+      if (spec%nlevel == 1 .or. any(levels(1:spec%nlevel) <= 0)) then
+        emsg = path//': group &verify: key ''levels'': none, or at least two increment '// &
+          'multipliers'; return
+      end if
+      if (spec%nlevel >= 2) then
+        if (min_order == -huge(1.0_wp) .and. max_order == huge(1.0_wp)) then
+          emsg = path//': group &verify: key ''min_order'' (or ''max_order''): required with '// &
+            '''levels'''; return
+        end if
+        if (min_order /= -huge(1.0_wp) .and. .not. (min_order > 0.0_wp)) then
+          emsg = path//': group &verify: key ''min_order'': a convergence order > 0'; return
+        end if
+        if (quick_levels < 2 .or. quick_levels > spec%nlevel) then
+          emsg = path//': group &verify: key ''quick_levels'': expected 2..'//str(spec%nlevel)
+          return
+        end if
+      end if
+      return
+    end if
     if (spec%nshape == 0 .or. spec%nscheme == 0) then
       emsg = path//': group &verify: keys ''shapes'' and ''schemes'': at least one each'; return
     end if
@@ -124,8 +168,8 @@ contains
       end if
       spec%nmetric = 1; spec%metrics(1) = metrics(1)
     case default
-      emsg = path//': group &verify: key ''study'': expected ''matrix'', ''space'' or '// &
-        '''time'', got '''//trim(study)//''''; return
+      emsg = path//': group &verify: key ''study'': expected ''matrix'', ''space'', '// &
+        '''time'' or ''stress_point'', got '''//trim(study)//''''; return
     end select
     if (spec%study /= 'matrix') then
       if (len_trim(spec%metrics(1)) == 0) then

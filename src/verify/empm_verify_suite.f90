@@ -18,6 +18,7 @@ module empm_verify_suite
   use empm_verify_spec, only: empm_verify_spec_t, empm_read_verify_spec
   use empm_verify_bench, only: empm_bench_t, bench_known
   use empm_verify_metrics, only: observed_orders, fitted_order, weighted_l2
+  use empm_verify_stress_point, only: empm_sp_study
   implicit none
   private
   public :: empm_verify_run, empm_glob_match
@@ -203,6 +204,21 @@ contains
       character(len=:), allocatable :: out, msg
       logical :: passed, ran, expected, ok, signature
       integer :: m, np
+      if (spec%study == 'stress_point') then
+        ! A material point driven through an element-test path (no grid, no scheme).
+        out = outdir//'/raw/'//flat(r%id)//'.h5'
+        call empm_sp_study(spec%file, max(1, spec%levels(r%ilevel)), out, &
+                           spec%metrics(1:spec%nmetric), val(1:spec%nmetric), hlevel, msg)
+        ran = len(msg) == 0
+        passed = ran
+        do m = 1, spec%nmetric
+          if (spec%thresholds(m) >= 0.0_wp) then
+            if (.not. (val(m) <= spec%thresholds(m))) passed = .false.
+          end if
+        end do
+        expected = .false.
+        ok = passed
+      else
       ov%shape = trim(spec%shapes(r%ishape)); ov%scheme = trim(spec%schemes(r%ischeme))
       if (spec%study == 'space') ov%refine = spec%levels(r%ilevel)
       if (spec%study == 'time' .and. r%ilevel == 1) then
@@ -274,6 +290,7 @@ contains
         end do
       end if
       ok = merge(signature, passed, expected)
+      end if
       if (.not. ok) nfail = nfail + 1
       call js%begin_object()
       call js%key('id'); call js%str_value(r%id)
@@ -364,8 +381,14 @@ contains
         call jc%key('id'); call jc%str_value(runs(a)%group)
         call jc%key('expected_failure'); call jc%bool_value(expected)
         call jc%key('within_bounds'); call jc%bool_value(within)
-        call jc%key('parameter'); call jc%str_value(merge('h  ', 'cfl', &
-          specs(runs(a)%spec)%study == 'space'))
+        select case (specs(runs(a)%spec)%study)
+        case ('space')
+          call jc%key('parameter'); call jc%str_value('h')
+        case ('stress_point')
+          call jc%key('parameter'); call jc%str_value('dt')
+        case default
+          call jc%key('parameter'); call jc%str_value('cfl')
+        end select
         if (specs(runs(a)%spec)%study == 'time') then
           call jc%key('metric'); call jc%str_value('temporal_'//trim(specs(runs(a)%spec)%metrics(1)))
         else
@@ -441,7 +464,13 @@ contains
       if (len_trim(line) == 0 .or. line(1:1) == '#') cycle
       call empm_read_verify_spec(dir//trim(line), sp, emsg)
       if (len(emsg) > 0) exit
-      if (.not. bench_known(sp%benchmark)) then
+      if (sp%study == 'stress_point') then
+        if (sp%benchmark /= 'stress_point' .and. sp%benchmark /= 'objectivity') then
+          emsg = dir//trim(line)//': group &verify: study = ''stress_point'' takes benchmark '// &
+            '''stress_point'' or ''objectivity'''
+          exit
+        end if
+      else if (.not. bench_known(sp%benchmark)) then
         emsg = dir//trim(line)//': group &verify: unknown benchmark '''//trim(sp%benchmark)//''''
         exit
       end if
@@ -463,7 +492,23 @@ contains
     do s = 1, size(specs)
       if (quick .and. .not. specs(s)%quick) cycle
       nl = max(1, specs(s)%nlevel)
-      if (quick .and. specs(s)%study /= 'matrix') nl = specs(s)%quick_levels
+      if (quick .and. specs(s)%study /= 'matrix' .and. specs(s)%nlevel >= 2) &
+        nl = specs(s)%quick_levels
+      if (specs(s)%study == 'stress_point') then
+        ! One run per level (increment multiplier); a convergence group when there are levels.
+        do l = 1, nl
+          r%spec = s; r%ishape = 0; r%ischeme = 0; r%ilevel = l
+          r%group = ''
+          r%id = trim(specs(s)%benchmark)//'/'//trim(specs(s)%label)
+          if (specs(s)%nlevel >= 2) then
+            r%group = r%id; r%id = r%id//'/'//str(l)
+          end if
+          n = size(runs)
+          allocate(tmp(n + 1)); tmp(1:n) = runs; tmp(n + 1) = r
+          call move_alloc(tmp, runs)
+        end do
+        cycle
+      end if
       do j = 1, specs(s)%nscheme
         do i = 1, specs(s)%nshape
           do l = 1, nl
