@@ -305,21 +305,22 @@ def stress_point_section(s):
             p = -st[:3].mean(axis=0)
             m = -p
             q = np.sqrt(1.5 * ((st[:3] - m) ** 2).sum(axis=0) + 3 * (st[3:] ** 2).sum(axis=0))
-            line, = ax.plot(p / 1e3, q / 1e3, lw=1.2, label=c["id"].split("/")[1])
+            line, = ax.plot(p / 1e3, q / 1e3, "o", ms=3, markevery=max(1, len(p) // 25),
+                            label=c["id"].split("/")[1] + " (points: empm)")
             M, p0 = at["M"], p[0]
             if path == "mcc_drained":
                 pe = 3 * p0 / (3 - M)
-                ax.plot([p0 / 1e3, pe / 1e3], [0, M * pe / 1e3], ":", color=line.get_color(),
+                ax.plot([p0 / 1e3, pe / 1e3], [0, M * pe / 1e3], "-", color=line.get_color(),
                         lw=1)
             else:
                 eta = np.linspace(0, M, 200)
                 pc0, L = at.get("pc0", p0), at["Lambda"]
                 pe = p0 * ((pc0 / p0) * M ** 2 / (M ** 2 + eta ** 2)) ** L
-                ax.plot(pe / 1e3, eta * pe / 1e3, ":", color=line.get_color(), lw=1)
+                ax.plot(pe / 1e3, eta * pe / 1e3, "-", color=line.get_color(), lw=1)
             pp = np.linspace(0, p.max() * 1.1, 10)
             ax.plot(pp / 1e3, M * pp / 1e3, "k--", lw=0.6)
         ax.set_xlabel("p' [kPa]"); ax.set_ylabel("q [kPa]"); ax.grid(alpha=0.3)
-        ax.set_title("Modified Cam-Clay: q–p' paths (dotted: closed forms; dashed: CSL)")
+        ax.set_title("Modified Cam-Clay: q–p' paths (lines: closed forms; dashed: CSL)")
         ax.legend(fontsize=7)
         lines += [f"![MCC]({savefig(fig, 'stress_point_mcc.png')})", ""]
     lines += convergence_section(conv, "objectivity.png",

@@ -24,7 +24,7 @@ module empm_stress_point
   implicit none
   private
   public :: empm_sp_point_t, empm_sp_history_t, empm_sp_check_t, empm_sp_segment
-  public :: empm_sp_increment, empm_sp_unit_rate
+  public :: empm_sp_increment, empm_sp_unit_rate, empm_sp_replay
 
   !> The state of the material point.
   type :: empm_sp_point_t
@@ -46,6 +46,9 @@ module empm_stress_point
     real(wp), allocatable :: stress(:,:)      !! stress (6, 0:n) [Pa]
     real(wp), allocatable :: strain(:,:)      !! strain (6, 0:n)
     real(wp), allocatable :: state(:,:)       !! state variables (nstate, 0:n)
+    real(wp), allocatable :: L(:,:,:)         !! velocity gradient of each increment, the
+                                              !! unknown rates included (3, 3, n); for
+                                              !! [[empm_sp_replay]] (set when nsub = 1)
     real(wp) :: max_yield = 0.0_wp            !! largest relative yield violation, over every
                                               !! sub-increment
     real(wp) :: max_residual = 0.0_wp         !! largest relative residual of the controlled
@@ -96,7 +99,7 @@ contains
   !> the components `mask`, solved so that those stress components equal `target` to `tol`
   !> relative to max(|target|, |σ|). `info`: 0 ok, > 0 the model failed (its own code), −1 no
   !> Newton convergence. `resid` is the final relative residual, `iters` the iterations.
-  subroutine empm_sp_increment(mat, pt, dt, L, mask, target, tol, info, resid, iters)
+  subroutine empm_sp_increment(mat, pt, dt, L, mask, target, tol, info, resid, iters, Lused)
     class(empm_material_t), intent(in) :: mat    !! the model
     type(empm_sp_point_t), intent(inout) :: pt   !! the point, advanced on success
     real(wp), intent(in) :: dt                   !! increment [s]
@@ -107,6 +110,7 @@ contains
     integer, intent(out) :: info                 !! 0, model code, or −1
     real(wp), intent(out) :: resid               !! final relative residual
     integer, intent(out) :: iters                !! Newton iterations
+    real(wp), intent(out), optional :: Lused(3,3) !! the gradient applied, unknowns included
     integer :: idx(6), nu, k, j, it, mi
     real(wp) :: x(6), xt(6), r(6), rt(6), jac(6,6), dx(6), h, scale, rnorm, rnew, lam, xscale
     real(wp) :: s(6)
@@ -118,6 +122,7 @@ contains
       end if
     end do
     iters = 0; resid = 0.0_wp
+    if (present(Lused)) Lused = L
     if (nu == 0) then
       call advance(pt, [real(wp) ::], s, info)
       if (info == 0) call accept(s)
@@ -198,6 +203,7 @@ contains
       trial%F = Ft(:,:,1); trial%strain = et(:,1); trial%stress = st(:,1); trial%rho = rt1(1)
       trial%state = zt(1:size(p0%state), 1)
       ss = st(:,1)
+      if (present(Lused)) Lused = Lt(:,:,1)
     end subroutine advance
 
     subroutine residual(xu, ru, ss, inf)
@@ -264,12 +270,13 @@ contains
     class(empm_sp_check_t), intent(in), optional :: check !! yield check
     real(wp), intent(in), optional :: tol              !! Newton tolerance (default 1e-13)
     integer :: k, m, it, ns
-    real(wp) :: dt, w, resid, tl
+    real(wp) :: dt, w, resid, tl, Lk(3,3)
     tl = 1.0e-13_wp
     if (present(tol)) tl = tol
     ns = size(pt%state)
     hist%n = n
     allocate(hist%t(0:n), hist%stress(6, 0:n), hist%strain(6, 0:n), hist%state(ns, 0:n))
+    allocate(hist%L(3, 3, n)); hist%L = 0.0_wp
     hist%t(0) = pt%t; hist%stress(:,0) = pt%stress; hist%strain(:,0) = pt%strain
     hist%state(:,0) = pt%state
     hist%max_yield = 0.0_wp; hist%max_residual = 0.0_wp; hist%newton_max = 0
@@ -280,7 +287,7 @@ contains
       do m = 1, nsub
         w = real((k - 1) * nsub + m, wp) / real(n * nsub, wp)
         call empm_sp_increment(mat, pt, dt, L, mask, (1.0_wp - w) * target0 + w * target1, &
-                               tl, info, resid, it)
+                               tl, info, resid, it, Lk)
         if (info /= 0) then
           hist%n = k - 1; return
         end if
@@ -291,6 +298,49 @@ contains
       end do
       hist%t(k) = pt%t; hist%stress(:,k) = pt%stress; hist%strain(:,k) = pt%strain
       hist%state(:,k) = pt%state
+      if (nsub == 1) hist%L(:,:,k) = Lk
     end do
   end subroutine empm_sp_segment
+
+  !> Replay the increments of `ref` (a run with nsub = 1) under strain control, each split
+  !> into `nsub` equal sub-increments of the same velocity gradient, i.e. the same straight
+  !> strain path: the test of whether a model's result depends on how an increment is split.
+  !> (Re-solving a mixed-control path with smaller increments would follow a different strain
+  !> path, which is a discretisation of the path, not a property of the model.)
+  subroutine empm_sp_replay(mat, pt, ref, nsub, hist, info, check)
+    class(empm_material_t), intent(in) :: mat          !! the model
+    type(empm_sp_point_t), intent(inout) :: pt         !! the point (at the start of `ref`)
+    type(empm_sp_history_t), intent(in) :: ref         !! the reference run
+    integer, intent(in) :: nsub                        !! sub-increments per increment
+    type(empm_sp_history_t), intent(out) :: hist       !! the record
+    integer, intent(out) :: info                       !! 0 ok
+    class(empm_sp_check_t), intent(in), optional :: check !! yield check
+    integer :: k, m, it, ns, n
+    real(wp) :: dt, resid
+    logical, parameter :: NOMASK(6) = .false.
+    n = ref%n
+    ns = size(pt%state)
+    hist%n = n
+    allocate(hist%t(0:n), hist%stress(6, 0:n), hist%strain(6, 0:n), hist%state(ns, 0:n))
+    allocate(hist%L(3, 3, n)); hist%L = ref%L(:,:,1:n)
+    hist%t(0) = pt%t; hist%stress(:,0) = pt%stress; hist%strain(:,0) = pt%strain
+    hist%state(:,0) = pt%state
+    hist%max_yield = 0.0_wp; hist%max_residual = 0.0_wp; hist%newton_max = 0
+    if (present(check)) hist%max_yield = check%violation(pt%stress, pt%state)
+    info = 0
+    do k = 1, n
+      dt = (ref%t(k) - ref%t(k - 1)) / real(nsub, wp)
+      do m = 1, nsub
+        call empm_sp_increment(mat, pt, dt, ref%L(:,:,k), NOMASK, pt%stress, 0.0_wp, info, &
+                               resid, it)
+        if (info /= 0) then
+          hist%n = k - 1; return
+        end if
+        if (present(check)) hist%max_yield = max(hist%max_yield, &
+                                                 check%violation(pt%stress, pt%state))
+      end do
+      hist%t(k) = pt%t; hist%stress(:,k) = pt%stress; hist%strain(:,k) = pt%strain
+      hist%state(:,k) = pt%state
+    end do
+  end subroutine empm_sp_replay
 end module empm_stress_point

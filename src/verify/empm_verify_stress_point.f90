@@ -15,8 +15,9 @@
 !> path q = 3(p' − p'0); undrained: p' against the closed-form p'(η) on the yield surface),
 !> `yield_violation` (largest relative violation of the yield condition after every update,
 !> from a model-independent check), `split_dependence` (largest difference of the stresses at
-!> the increment ends between the path and the same path with every increment split into
-!> `split`, relative to the largest stress), `split_dependence_end` (the same at the end of the
+!> the increment ends between the path and a replay of its increments (the velocity gradients
+!> the path applied, unknown rates included) each split into `split` equal sub-increments,
+!> relative to the largest stress), `split_dependence_end` (the same at the end of the
 !> path only), `control_residual` (largest relative residual of the stress-controlled
 !> components).
 module empm_verify_stress_point
@@ -33,7 +34,7 @@ module empm_verify_stress_point
   use empm_input, only: empm_input_group_params
   use empm_h5, only: hid_t, h5_write, h5_attr
   use empm_stress_point, only: empm_sp_point_t, empm_sp_history_t, empm_sp_check_t, &
-    empm_sp_segment
+    empm_sp_segment, empm_sp_replay
   use empm_exact_soil, only: empm_mc_triax_compression, empm_mc_triax_extension, empm_dp_match, &
     empm_dp_triax_compression, empm_dp_triax_extension, empm_dp_plane_strain, &
     empm_simple_shear_ratio, empm_mcc_drained_end, empm_mcc_undrained_p, &
@@ -216,7 +217,7 @@ contains
     end if
     if (split > 1) then
       pt = p0
-      call empm_sp_segment(mat, pt, L, mask, s0, s0, T, steps * factor, split, h2, info, chk)
+      call empm_sp_replay(mat, pt, h1, split, h2, info, chk)
       if (info /= 0) then
         msg = 'the split path stopped at increment '//str(h2%n + 1)//' (code '//str(info)//')'
         return
