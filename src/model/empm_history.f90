@@ -101,8 +101,8 @@ contains
     type(empm_model_t), intent(in), optional :: model !! model (residual, reactions)
     integer :: k, p, nd
     if (present(model)) then
-      if (model%track .and. .not. self%tracked) then
-        if (self%nt > 0) return ! tracking must start with the first sample
+      ! Tracking starts with the first sample (a model tracked only later is not recorded).
+      if (model%track .and. .not. self%tracked .and. self%nt == 0) then
         self%tracked = .true.; self%nset = model%nodes%nset; nd = model%grid%ndim
         allocate(self%residual(size(self%t)), self%set_name(self%nset), &
           self%reaction(nd, self%nset, size(self%t)), self%set_disp(nd, self%nset, size(self%t)))

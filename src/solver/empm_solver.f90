@@ -384,7 +384,8 @@ contains
   !> (drift -2.1E-06)`, with `, gravity ramp work W J` before the drift when gravity varies.
   !> The drift is (E_final − E_initial − W) / max(|E_initial|, |E_final|, |W|) of the total
   !> energy (kinetic + strain + gravity potential); work done by prescribed non-zero boundary
-  !> velocities is not subtracted and shows in it.
+  !> velocities is not subtracted and shows in it. A run that tracked its residual (model%track)
+  !> ends with `; residual R`, its last value.
   function empm_run_summary(st) result(s)
     type(empm_run_stats_t), intent(in) :: st !! statistics of a run
     character(len=:), allocatable :: s       !! the line (no trailing newline)
