@@ -134,6 +134,20 @@ contains
     call h5_write(g, 'kinetic_energy', hist%kinetic(1:hist%nt), ierr)
     call h5_write(g, 'strain_energy', hist%strain(1:hist%nt), ierr)
     call h5_write(g, 'gravity_potential', hist%gravity(1:hist%nt), ierr)
+    if (hist%tracked) then
+      ! Residual and reactions (docs/output.md), recorded when the model tracks them.
+      call h5_write(g, 'residual', hist%residual(1:hist%nt), ierr)
+      if (hist%nset > 0) then
+        call h5_group(g, 'reaction', gs, ierr)
+        do k = 1, hist%nset
+          call h5_group(gs, trim(hist%set_name(k)), gp, ierr)
+          call h5_write(gp, 'force', hist%reaction(:, k, 1:hist%nt), ierr)
+          call h5_write(gp, 'displacement', hist%set_disp(:, k, 1:hist%nt), ierr)
+          call h5_close_group(gp, ierr)
+        end do
+        call h5_close_group(gs, ierr)
+      end if
+    end if
     call h5_close_group(g, ierr)
 
     call h5_group(fid, 'probes', gs, ierr)
