@@ -86,7 +86,8 @@ contains
           'mesh (.msh), relative to the case file''s folder (required for a file)', &
           optional=.true.), &
         empm_param('ppc', PARAM_INT, '-', 'particles per cell per direction (ppc^ndim per '// &
-          'cell); for a mesh, the quadrature order per direction', default='2', lo=1.0_wp, &
+          'cell; the particles must fit in memory, estimated before they are generated); for a '// &
+          'mesh, the quadrature order per direction', default='2', lo=1.0_wp, &
           hi=4.0_wp), &
         empm_param('placement', PARAM_STR, '-', 'gauss: Gauss-Legendre points, volume = Gauss '// &
           'weight x cell volume; voxel: centres of ppc^ndim equal sub-cells', &
@@ -464,6 +465,7 @@ contains
     real(wp) :: lo(3), hi(3), center(3), radius, velocity(3), amp(3), wavenumber(3), phase, &
                 stress(6)
     integer :: ppc, info, nbody, imat, i, geom, place, nadded, p0, q, nd, k, n, nlo, nhi, nc
+    integer(int64) :: nest
     type(empm_body_points_t) :: body
     character(len=:), allocatable :: bname
     logical :: geostatic
@@ -473,6 +475,7 @@ contains
     nbody = 0
     allocate(cs%body_name(0), cs%body_first(0), cs%body_last(0), cs%body_k0(0), &
       cs%body_group(0), cs%body_lo(3, 0), cs%body_hi(3, 0), cs%body_box(0))
+    nest = 0
     do k = 1, size(gs)
       if (gs(k)%name /= 'particles') cycle
       g = gs(k)
@@ -570,6 +573,10 @@ contains
         end if
       end select
       place = merge(PLACE_GAUSS, PLACE_VOXEL, placement == 'gauss')
+      ! Refuse up front a body set whose particles would not fit in memory.
+      nest = nest + estimate_particles(cs%model%grid, geom, lo, hi, center, radius, ppc)
+      call check_particle_memory(g, cs, nest, e)
+      if (e%code /= EMPM_OK) return
       p0 = cs%model%pts%np
       call empm_fill(cs%model%pts, cs%model%grid, geom, lo, hi, center, radius, ppc, place, &
         cs%model%mats(imat)%model%rho0, imat, nadded, info)
@@ -648,6 +655,80 @@ contains
       end do
     end subroutine read_file_body
   end subroutine read_particles
+
+  ! Particles a box or disk/ball body gets at most: the cells its bounding box overlaps (within
+  ! the grid) times ppc per direction, times the disk's (π/4) or ball's (π/6) share of its
+  ! bounding square or cube. 64-bit: the product exceeds 2^31 for large cases.
+  function estimate_particles(grid, geom, lo, hi, center, radius, ppc) result(n)
+    use empm_grid, only: empm_grid_t
+    type(empm_grid_t), intent(in) :: grid
+    integer, intent(in) :: geom, ppc
+    real(wp), intent(in) :: lo(3), hi(3), center(3), radius
+    integer(int64) :: n
+    real(wp) :: a(3), b(3), top(3), cells, share
+    integer :: d, nd
+    nd = grid%ndim
+    top = grid%upper()
+    if (geom == GEOM_BOX) then
+      a = lo; b = hi; share = 1.0_wp
+    else
+      a = center - radius; b = center + radius
+      share = merge(acos(-1.0_wp) / 4.0_wp, acos(-1.0_wp) / 6.0_wp, nd == 2)
+    end if
+    cells = 1.0_wp
+    do d = 1, nd
+      a(d) = max(a(d), grid%origin(d)); b(d) = min(b(d), top(d))
+      if (b(d) <= a(d)) then
+        n = 0; return
+      end if
+      cells = cells * min(real(grid%ncell(d), wp), real(ceiling((b(d) - a(d)) / grid%h(d)), wp) &
+        + 1.0_wp)
+    end do
+    n = int(min(share * cells * real(ppc, wp)**nd, 9.0e18_wp), int64)
+  end function estimate_particles
+
+  ! The memory `np` particles need with the nodes (estimate): per particle its storage
+  ! (positions, velocities, accelerations, reference positions, domain half-lengths and LME
+  ! multipliers: 7 ndim values; masses, volumes, densities: 4; stress, strain: 12; F: 9; the
+  ! state variables; the material index), the solver's copy of the last good state (as much
+  ! again), the shape-function basis (max_nodes node indices, values and ndim gradients) and
+  ! scratch; refused (key ppc) when above the machine's physical memory.
+  subroutine check_particle_memory(g, cs, np, e)
+    type(empm_group_t), intent(in) :: g
+    type(empm_case_t), intent(in) :: cs
+    integer(int64), intent(in) :: np
+    type(empm_error_t), intent(inout) :: e
+    integer(int64) :: per, maxn, nnode, bytes, mem, nstate
+    integer :: nd, im
+    nd = cs%model%grid%ndim
+    nstate = 0
+    do im = 1, size(cs%model%mats)
+      nstate = max(nstate, int(cs%model%mats(im)%model%nstate(), int64))
+    end do
+    maxn = cs%model%shape%max_nodes(cs%model%grid)
+    per = 2_int64 * (8_int64 * (7_int64 * nd + 25_int64 + nstate) + 4_int64) + &
+      maxn * (4_int64 + 8_int64 + 8_int64 * nd) + 4_int64 + 8_int64 * (2_int64 * nd + 1_int64)
+    nnode = product(int(cs%model%grid%ncell(1:nd), int64) + 1_int64)
+    bytes = np * per + nnode * (8_int64 + 52_int64 * nd)
+    mem = empm_physical_memory()
+    if (np > int(huge(1), int64)) then
+      call g%fail(e, 'ppc', 'the bodies would have about '//i64(np)// &
+        ' particles, more than '//str(huge(1))//' (particle numbers are default integers)')
+    else if (mem > 0 .and. bytes > mem) then
+      call g%fail(e, 'ppc', 'the bodies would have about '//i64(np)// &
+        ' particles, which with the grid need about '//str_short(real(bytes, wp) / 2.0_wp**30)// &
+        ' GiB ('//i64(bytes)//' bytes), more than this machine''s '// &
+        str_short(real(mem, wp) / 2.0_wp**30)//' GiB ('//i64(mem)//' bytes)')
+    end if
+  contains
+    pure function i64(v) result(t)
+      integer(int64), intent(in) :: v
+      character(len=:), allocatable :: t
+      character(len=24) :: b
+      write(b, '(i0)') v
+      t = trim(b)
+    end function i64
+  end subroutine check_particle_memory
 
   subroutine read_integrator(path, gs, cs, ov, reg, e)
     character(len=*), intent(in) :: path
