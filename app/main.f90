@@ -6,6 +6,7 @@ program empm_main
   use empm_parallel, only: empm_set_threads
   use empm_solver, only: empm_run_stats_t, empm_run_summary
   use empm_files, only: empm_mkdir_p
+  use empm_posix, only: empm_ignore_sigxfsz
   use empm_verify_suite, only: empm_verify_run
   use empm_input, only: empm_input_markdown
   use empm_bench, only: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json
@@ -52,6 +53,8 @@ program empm_main
     end do
     if (len(case_file) == 0) call die('empm run needs a case file: empm run CASE.nml')
     if (nthreads > 0) call empm_set_threads(nthreads)
+    ! Beyond the file-size limit (ulimit -f) a write fails and is reported (status 4).
+    call empm_ignore_sigxfsz()
     ! A verification case file also runs: its &verify group is the suite's, not the run's.
     call empm_run_case(case_file, out_file, written=written, err=err, extra_groups='verify', &
                        stats=stats)
@@ -177,6 +180,7 @@ contains
     write(u, '(a)') ''
     write(u, '(a)') 'exit status: 0 success, 1 usage error, 2 invalid case file,'
     write(u, '(a)') '             3 run stopped by a guard (results marked incomplete), 4 I/O error'
+    write(u, '(a)') '             (also when another run is writing OUT.h5: its lock OUT.h5.lock)'
   end subroutine usage_run
 
   subroutine usage_verify(u)

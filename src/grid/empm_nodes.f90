@@ -26,6 +26,17 @@ module empm_nodes
     real(wp), allocatable, private :: vfix(:,:)     !! prescribed velocity (ndim, nnode) [m/s]
     integer, allocatable, private :: fixed_dofs(:)  !! the fixed dofs as positions
                                                     !! d + ndim (I − 1), increasing
+    ! Named node sets whose reaction is recorded (`&boundary name`): set s owns the dofs
+    ! set_dof(set_ptr(s):set_ptr(s+1)−1), those its box fixed when it was declared.
+    integer :: nset = 0                             !! number of reaction sets
+    character(len=64), allocatable :: set_name(:)   !! their names (nset)
+    integer, allocatable :: set_ptr(:)              !! first dof of each set in set_dof (nset+1)
+    integer, allocatable :: set_dof(:)              !! dofs of the sets, as in fixed_dofs
+    logical, allocatable :: set_fix(:,:)            !! components each set prescribes (ndim, nset)
+    real(wp), allocatable :: set_vel(:,:)           !! their prescribed velocity (ndim, nset) [m/s]
+    real(wp), allocatable :: reaction(:,:)          !! reaction force of each set from the last
+                                                    !! assembly (ndim, nset) [N], see
+                                                    !! [[nodes_compute_reactions]]
   contains
     procedure :: alloc => nodes_alloc
     procedure :: reset => nodes_reset
@@ -36,6 +47,8 @@ module empm_nodes
     procedure :: nfixed => nodes_nfixed
     procedure :: constrain_velocity => nodes_constrain_velocity
     procedure :: constrain_force => nodes_constrain_force
+    procedure :: compute_reactions => nodes_compute_reactions
+    procedure :: local_damping => nodes_local_damping
     procedure, private :: list_fixed => nodes_list_fixed
   end type empm_nodes_t
 
@@ -63,6 +76,12 @@ contains
     end if
     self%fixed = .false.; self%vfix = 0.0_wp
     call self%list_fixed()
+    self%nset = 0
+    if (allocated(self%set_name)) deallocate(self%set_name, self%set_ptr, self%set_dof, &
+      self%set_fix, self%set_vel, self%reaction)
+    allocate(self%set_name(0), self%set_ptr(1), self%set_dof(0), self%set_fix(d, 0), &
+      self%set_vel(d, 0), self%reaction(d, 0))
+    self%set_ptr(1) = 1
     call zero(self%mass, n); call zero(self%mom, d * n); call zero(self%vel, d * n)
     call zero(self%force, d * n); call zero(self%acc, d * n); call zero(self%work, d * n)
   end subroutine nodes_alloc
@@ -92,8 +111,9 @@ contains
 
   !> Constrain components `comp` of every node inside the closed box [lo, hi] (a node set by
   !> geometry) to the velocity `value`. Returns the number of nodes selected. Allocates the
-  !> nodal storage on first use.
-  subroutine nodes_fix_box(self, grid, lo, hi, comp, value, nsel)
+  !> nodal storage on first use. With `name`, the dofs fixed here also form a reaction set
+  !> of that name, whose reaction force [[nodes_compute_reactions]] records.
+  subroutine nodes_fix_box(self, grid, lo, hi, comp, value, nsel, name)
     class(empm_nodes_t), intent(inout) :: self !! nodal fields
     type(empm_grid_t), intent(in) :: grid      !! background grid
     real(wp), intent(in) :: lo(3)              !! lower corner of the selection box [m]
@@ -101,12 +121,15 @@ contains
     logical, intent(in) :: comp(3)             !! which velocity components to prescribe
     real(wp), intent(in) :: value(3)           !! prescribed velocity components [m/s]
     integer, intent(out) :: nsel               !! number of nodes selected
+    character(len=*), intent(in), optional :: name !! name of the reaction set to record
     real(wp) :: xi(3), tol
-    integer :: id, d
+    integer :: id, d, nd
+    integer, allocatable :: dofs(:)
     if (.not. allocated(self%mass) .or. self%nnode /= grid%nnode) call self%alloc(grid)
     ! A node counts as inside when within a small fraction of a cell of the box.
     tol = 1.0e-9_wp * grid%hmin()
-    nsel = 0
+    nsel = 0; nd = grid%ndim
+    allocate(dofs(0))
     do id = 1, grid%nnode
       xi = grid%node_coord(id)
       if (all(xi(1:grid%ndim) >= lo(1:grid%ndim) - tol .and. &
@@ -116,12 +139,81 @@ contains
           if (comp(d)) then
             self%fixed(d, id) = .true.
             self%vfix(d, id) = value(d)
+            if (present(name)) dofs = [dofs, d + nd * (id - 1)]
           end if
         end do
       end if
     end do
     call self%list_fixed()
+    if (present(name)) call add_set(self, name, dofs, comp(1:nd), value(1:nd))
   end subroutine nodes_fix_box
+
+  !> Append the reaction set `name` (set-up only).
+  subroutine add_set(self, name, dofs, comp, value)
+    type(empm_nodes_t), intent(inout) :: self
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: dofs(:)
+    logical, intent(in) :: comp(:)
+    real(wp), intent(in) :: value(:)
+    character(len=64), allocatable :: names(:)
+    logical, allocatable :: fx(:,:)
+    real(wp), allocatable :: r(:,:)
+    integer :: n
+    n = self%nset + 1; self%nset = n
+    names = [character(len=64) :: self%set_name, name]; call move_alloc(names, self%set_name)
+    self%set_ptr = [self%set_ptr, self%set_ptr(n) + size(dofs)]
+    self%set_dof = [self%set_dof, dofs]
+    allocate(fx(self%ndim, n)); fx(:, 1:n - 1) = self%set_fix; fx(:, n) = comp
+    call move_alloc(fx, self%set_fix)
+    allocate(r(self%ndim, n)); r(:, 1:n - 1) = self%set_vel; r(:, n) = merge(value, 0.0_wp, comp)
+    call move_alloc(r, self%set_vel)
+    deallocate(self%reaction); allocate(self%reaction(self%ndim, n)); self%reaction = 0.0_wp
+  end subroutine add_set
+
+  !> Reaction force of every reaction set from the total nodal force `f` (internal + external,
+  !> before the fixed dofs are zeroed): R_s = Σ over the set's dofs of (m_I a_prescribed − f_I)
+  !> = −Σ f_I, the prescribed velocities being constant in time. R is the force the support
+  !> exerts on the body (a base carrying a body's weight W pushes up: R = +W along the up axis).
+  !> A dof in several sets counts in each.
+  pure subroutine nodes_compute_reactions(self, f)
+    class(empm_nodes_t), intent(inout) :: self     !! nodal fields (reaction is set)
+    real(wp), intent(in), contiguous :: f(:,:)     !! total nodal force (ndim, nnode) [N]
+    call set_sums(self%nset, self%ndim, self%set_ptr, self%set_dof, f, self%reaction)
+  end subroutine nodes_compute_reactions
+
+  pure subroutine set_sums(nset, nd, ptr, dofs, f, r)
+    integer, intent(in) :: nset, nd
+    integer, intent(in) :: ptr(nset + 1), dofs(*)
+    real(wp), intent(in) :: f(*)
+    real(wp), intent(out) :: r(nd, nset)
+    integer :: s, k, j
+    r = 0.0_wp
+    do s = 1, nset
+      do k = ptr(s), ptr(s + 1) - 1
+        j = dofs(k)
+        r(mod(j - 1, nd) + 1, s) = r(mod(j - 1, nd) + 1, s) - f(j)
+      end do
+    end do
+  end subroutine set_sums
+
+  !> Local non-viscous (Cundall) damping of the nodal force: f_Id −= α |f_Id| sgn(v_Id) on
+  !> every dof (sgn 0 = 0: a node at rest is not damped); the fixed dofs are zeroed later anyway.
+  pure subroutine nodes_local_damping(self, alpha, v, f)
+    class(empm_nodes_t), intent(in) :: self        !! nodal fields
+    real(wp), intent(in) :: alpha                  !! damping coefficient α in [0, 1)
+    real(wp), intent(in), contiguous :: v(:,:)     !! nodal velocities (ndim, nnode) [m/s]
+    real(wp), intent(inout), contiguous :: f(:,:)  !! nodal force (ndim, nnode) [N]
+    integer :: i, d
+    do i = 1, self%nnode
+      do d = 1, self%ndim
+        if (v(d, i) > 0.0_wp) then
+          f(d, i) = f(d, i) - alpha * abs(f(d, i))
+        else if (v(d, i) < 0.0_wp) then
+          f(d, i) = f(d, i) + alpha * abs(f(d, i))
+        end if
+      end do
+    end do
+  end subroutine nodes_local_damping
 
   !> Rebuild `fixed_dofs` from `fixed`, so that the constraint passes of every step visit the
   !> fixed dofs only (none, usually, or a boundary's worth) instead of every node.

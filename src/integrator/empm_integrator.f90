@@ -16,6 +16,7 @@ module empm_integrator
                            velocity_gradient, empm_p2g_work_t
   use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID
   use empm_material, only: empm_material_ctx_t
+  use empm_shape, only: BASIS_Q4, basis_q4_weights
   use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds
   implicit none
   private
@@ -30,6 +31,10 @@ module empm_integrator
   !> (`params`) and reads them from the `&integrator` group (`configure`).
   type, abstract, extends(empm_family_t) :: empm_integrator_t
     real(wp), allocatable :: bwork(:,:)  !! body-force scratch (ndim, np)
+    real(wp) :: damping = 0.0_wp         !! local non-viscous damping coefficient α in [0, 1)
+                                         !! ([[assemble_forces]]); 0: none
+    real(wp), allocatable :: tforce(:,:) !! nodal traction forces of the last assembly
+                                         !! (ndim, nnode); allocated with tractions only
     type(empm_p2g_work_t) :: p2g         !! per-thread P2G buffers (sized in `prepare`)
     type(empm_phase_timer_t) :: timer    !! wall time per phase of the step, Newton iterations
   contains
@@ -89,11 +94,59 @@ contains
       return
     end if
     self%bwork = 0.0_wp
+    call prepare_tractions(model, stat, msg)
+    if (stat == 0 .and. model%loads%ntraction() > 0) then
+      if (allocated(self%tforce)) deallocate(self%tforce)
+      allocate(self%tforce(model%grid%ndim, model%grid%nnode), stat=stat, errmsg=msg)
+    end if
+    if (stat /= 0) then
+      call empm_raise_error(empm_alloc_error('traction work arrays', 0_int64, msg), err)
+      return
+    end if
     ! Threads are fixed here: P2G sums depend on the chunking, so it must not change mid-run.
     call self%p2g%init(model%grid%ndim, model%grid%nnode, model%pts%np, empm_max_threads())
     call self%timer%reset()
     call self%start(model)
+    if (model%track) call monitor_initial(self, model)
   end subroutine integrator_prepare
+
+  !> Size each traction's scratch (support nodes of one face centre) for the model's shape
+  !> family, and its shape-function state.
+  subroutine prepare_tractions(model, stat, msg)
+    type(empm_model_t), intent(inout) :: model
+    integer, intent(out) :: stat
+    character(len=*), intent(inout) :: msg
+    integer :: k, maxn, nd, n
+    stat = 0
+    if (model%loads%ntraction() == 0) return
+    nd = model%grid%ndim; maxn = model%shape%max_nodes(model%grid)
+    do k = 1, size(model%loads%tractions)
+      associate (tr => model%loads%tractions(k))
+        n = size(tr%part)
+        if (allocated(tr%node)) deallocate(tr%node, tr%N, tr%dN)
+        if (allocated(tr%lam)) deallocate(tr%lam)
+        allocate(tr%node(maxn), tr%N(maxn), tr%dN(nd, maxn), tr%lam(nd, n), stat=stat, &
+                 errmsg=msg)
+        if (stat /= 0) return
+        tr%lam = 0.0_wp
+      end associate
+    end do
+  end subroutine prepare_tractions
+
+  !> With `model%track`, the residual and reactions of the initial state (recorded by the
+  !> first history sample): shape functions, nodal masses and one force assembly. Nothing the
+  !> step uses is changed (every step recomputes these).
+  subroutine monitor_initial(self, model)
+    class(empm_integrator_t), intent(inout) :: self
+    type(empm_model_t), intent(inout) :: model
+    type(empm_step_status_t) :: stat
+    call eval_basis(model, stat, ws=self%p2g)
+    if (stat%code /= 0) return
+    call model%nodes%reset()
+    call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
+    model%nodes%vel = 0.0_wp ! no damping in this assembly
+    call self%assemble_forces(model, model%t)
+  end subroutine monitor_initial
 
   !> Scheme-specific initialisation hook; the default does nothing.
   subroutine integrator_start(self, model)
@@ -173,12 +226,17 @@ contains
   end subroutine map_velocity
 
   !> Total nodal force at time `t` (paper eqs. 16–17): reset, internal force from the current
-  !> stresses, gravity and the body-force callback; zeroed on fixed dofs.
+  !> stresses, gravity, the body-force callback and the surface tractions; then, when used, the
+  !> reactions of the named node sets (from the force before the fixed dofs are zeroed), the
+  !> fixed dofs zeroed, the residual ‖f_free‖₂/‖f_ext‖₂ (`model%track`; f_ext = m_I g + the
+  !> nodal traction forces, the body-force callback left out) and the local damping
+  !> f −= α |f| sgn(v) with the nodal velocities `nodes%vel` of the step. Without tractions,
+  !> reaction sets, tracking and damping the work is that of eqs. 16–17 alone.
   subroutine assemble_forces(self, model, t)
     class(empm_integrator_t), intent(inout) :: self !! integrator (body-force scratch)
     type(empm_model_t), intent(inout) :: model      !! simulation state
     real(wp), intent(in) :: t                       !! time at which loads are evaluated [s]
-    real(wp) :: g(3)
+    real(wp) :: g(3), fext2, funb
     integer :: np, d
     logical :: use_b
     np = model%pts%np; d = model%grid%ndim
@@ -191,8 +249,86 @@ contains
                                                 model%pts%x(:, 1:np), self%bwork(:, 1:np))
     call p2g_body_force(model%basis, model%pts%m, g(1:d), self%bwork, use_b, model%nodes%force, &
                         self%p2g)
+    if (model%loads%ntraction() > 0) then
+      ! The tractions' nodal forces apart (for the residual's ‖f_ext‖), then added.
+      self%tforce = 0.0_wp
+      call p2g_tractions(model, t, self%tforce)
+      model%nodes%force = model%nodes%force + self%tforce
+    end if
+    if (model%nodes%nset > 0) call model%nodes%compute_reactions(model%nodes%force)
     call model%nodes%constrain_force(model%nodes%force)
+    if (model%track) then
+      if (model%loads%ntraction() > 0) then
+        fext2 = ext_norm2(model%nodes%mass, g(1:d), self%tforce)
+      else
+        fext2 = sum(model%nodes%mass**2) * sum(g(1:d)**2)
+      end if
+      funb = sqrt(sum(model%nodes%force**2))
+      if (fext2 > 0.0_wp) then
+        model%residual = funb / sqrt(fext2)
+      else
+        model%residual = -1.0_wp
+      end if
+    end if
+    if (self%damping > 0.0_wp) call model%nodes%local_damping(self%damping, model%nodes%vel, &
+                                                               model%nodes%force)
   end subroutine assemble_forces
+
+  !> Σ_I |m_I g + t_I|², the squared norm of the nodal external force (gravity and tractions).
+  pure real(wp) function ext_norm2(mass, g, tf) result(s)
+    real(wp), intent(in) :: mass(:)     !! nodal masses
+    real(wp), intent(in) :: g(:)        !! gravity (ndim)
+    real(wp), intent(in) :: tf(:,:)     !! nodal traction forces (ndim, nnode)
+    integer :: i
+    s = 0.0_wp
+    do i = 1, size(mass)
+      s = s + sum((mass(i) * g + tf(:, i))**2)
+    end do
+  end function ext_norm2
+
+  !> Add the nodal forces of every traction at time `t` to `f`: per loaded particle the force
+  !> s(t) t A_p, spread with the shape functions on its face, x_p + offset_p side e_axis
+  !> (where the load acts); should those fail (a face centre outside the grid or beyond the
+  !> family's support), with the particle's own shape functions. Serial: the loaded particles
+  !> are few (a boundary layer).
+  subroutine p2g_tractions(model, t, f)
+    type(empm_model_t), intent(inout) :: model        !! simulation state
+    real(wp), intent(in) :: t                         !! time [s]
+    real(wp), intent(inout), contiguous :: f(:,:)     !! nodal forces (ndim, nnode)
+    real(wp) :: s, xf(3), fp(3), t1, t2, Nq(4), dNq(2, 4)
+    integer :: k, j, p, nd, nn, info, i, id
+    nd = model%grid%ndim
+    do k = 1, size(model%loads%tractions)
+      associate (tr => model%loads%tractions(k), b => model%basis)
+        s = tr%factor(t)
+        if (s == 0.0_wp) cycle
+        do j = 1, size(tr%part)
+          p = tr%part(j)
+          fp(1:nd) = (s * tr%area(j)) * tr%traction(1:nd)
+          xf(1:nd) = model%pts%x(:, p)
+          xf(tr%axis) = xf(tr%axis) + tr%side * tr%offset(j)
+          call model%shape%eval_point(model%grid, xf(1:nd), model%pts%lp(:, p), tr%lam(:, j), &
+                                      nn, tr%node, tr%N, tr%dN, info)
+          if (info == 0) then
+            do i = 1, nn
+              f(:, tr%node(i)) = f(:, tr%node(i)) + tr%N(i) * fp(1:nd)
+            end do
+          else if (b%layout == BASIS_Q4) then
+            id = b%cell(p); t1 = b%t(1, p); t2 = b%t(2, p)
+            call basis_q4_weights(t1, t2, b%inv_h(1), b%inv_h(2), Nq, dNq)
+            f(:, id) = f(:, id) + Nq(1) * fp(1:nd)
+            f(:, id + 1) = f(:, id + 1) + Nq(2) * fp(1:nd)
+            f(:, id + b%stride) = f(:, id + b%stride) + Nq(3) * fp(1:nd)
+            f(:, id + b%stride + 1) = f(:, id + b%stride + 1) + Nq(4) * fp(1:nd)
+          else
+            do i = 1, b%nn(p)
+              f(:, b%node(i, p)) = f(:, b%node(i, p)) + b%N(i, p) * fp(1:nd)
+            end do
+          end if
+        end do
+      end associate
+    end do
+  end subroutine p2g_tractions
 
   !> Strain and stress update of every particle from the nodal velocities `vel`: per block of
   !> STRESS_BLOCK particles, L_p = Σ v_I ⊗ ∇N_Ip into a small buffer, then one material call on

@@ -32,5 +32,14 @@ module empm_case
     integer, allocatable :: probe_particle(:)        !! particle followed by each probe
     character(len=:), allocatable :: shape_name      !! shape family identifier
     character(len=:), allocatable :: scheme_name     !! integrator identifier
+    ! Bodies (&particles groups, in order): their particles are body_first..body_last.
+    character(len=64), allocatable :: body_name(:)   !! body labels ('' when unnamed)
+    integer, allocatable :: body_first(:)            !! first particle of each body
+    integer, allocatable :: body_last(:)             !! last particle of each body
+    real(wp), allocatable :: body_k0(:)              !! K0 of a geostatic body, −1 otherwise
+    integer, allocatable :: body_group(:)            !! index of its group in the parsed file
+    real(wp), allocatable :: body_lo(:,:)            !! a box body's lower corner (3, nbody)
+    real(wp), allocatable :: body_hi(:,:)            !! a box body's upper corner (3, nbody)
+    logical, allocatable :: body_box(:)              !! the body is a box
   end type empm_case_t
 end module empm_case

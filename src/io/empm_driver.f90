@@ -6,7 +6,8 @@ module empm_driver
   use empm_input, only: empm_read_case
   use empm_history, only: empm_history_t
   use empm_solver, only: empm_solve, empm_run_stats_t
-  use empm_output, only: empm_write_results, empm_output_meta_t
+  use empm_output, only: empm_write_results, empm_output_meta_t, empm_output_claim, &
+    empm_output_release
   implicit none
   private
   public :: empm_run_case
@@ -16,6 +17,9 @@ contains
   !> Run the case in `path`, writing HDF5 to `output` (default: the case's &output file).
   !> Exit-status semantics when `err` is absent: 2 invalid input, 3 run-time guard, 4 I/O.
   !> A run stopped by a guard still writes its last good state, marked incomplete.
+  !> The output is checked and locked before the run: a folder, device or other non-regular
+  !> file at the output path is refused (status 2), and so is an output another live run is
+  !> writing (status 4, the lock `OUT.lock`).
   !> The state at the start is stored as the first snapshot (t = 0, `/snapshots/000000`) even
   !> when the case's `snapshot_times` do not include it, unless `initial_snapshot` is false.
   subroutine empm_run_case(path, output, progress, written, err, extra_groups, stats, &
@@ -47,6 +51,10 @@ contains
       if (len_trim(output) > 0) cs%output_file = trim(output)
     end if
     if (present(progress)) cs%run%progress = progress
+    call empm_output_claim(cs%output_file, e)
+    if (e%code /= EMPM_OK) then
+      call empm_raise_error(e, err); return
+    end if
     ! A first frame at the start time, so that viewers show the undeformed state. The solver
     ! stores it before the first step: the time steps are unchanged.
     add0 = .true.
@@ -65,6 +73,7 @@ contains
     else
       call empm_write_results(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
     end if
+    call empm_output_release(cs%output_file)
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then
       ! The guard's error, with its location fields; the message says where the state went.

@@ -21,7 +21,7 @@ module empm_input
   use empm_namelist, only: empm_group_t, empm_parse_namelist
   use empm_case, only: empm_case_t, empm_overrides_t
   use empm_model, only: empm_material_slot_t
-  use empm_loads, only: RAMP_NONE, RAMP_SINE
+  use empm_loads, only: RAMP_NONE, RAMP_SINE, RAMP_LINEAR, empm_traction_t, empm_geostatic_stress
   use empm_particle_gen, only: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
   use empm_shape, only: shape_status_text
   use empm_registry, only: empm_registry_t, empm_default_registry
@@ -32,8 +32,11 @@ module empm_input
   public :: empm_read_case, empm_input_markdown, empm_input_group_params
 
   character(len=*), parameter :: GROUPS = 'grid material particles shape integrator loads '// &
-                                          'boundary probe output'
-  character(len=*), parameter :: REPEATABLE = 'material particles boundary probe'
+                                          'traction boundary probe output'
+  character(len=*), parameter :: REPEATABLE = 'material particles traction boundary probe'
+  !> Characters of a name that becomes an HDF5 group (a '/' would make it a path).
+  character(len=*), parameter :: NAME_CHARS = &
+    'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-'
   integer, parameter :: MAXSNAP = 1000          !! capacity of output%snapshot_times
   !> Largest magnitude of a length or coordinate [m] (and of a speed [m/s], an acceleration
   !> [m/s²]): beyond it the products a step forms (x², m v², σ V) overflow double precision.
@@ -83,7 +86,8 @@ contains
           'mesh (.msh), relative to the case file''s folder (required for a file)', &
           optional=.true.), &
         empm_param('ppc', PARAM_INT, '-', 'particles per cell per direction (ppc^ndim per '// &
-          'cell); for a mesh, the quadrature order per direction', default='2', lo=1.0_wp, &
+          'cell; the particles must fit in memory, estimated before they are generated); for a '// &
+          'mesh, the quadrature order per direction', default='2', lo=1.0_wp, &
           hi=4.0_wp), &
         empm_param('placement', PARAM_STR, '-', 'gauss: Gauss-Legendre points, volume = Gauss '// &
           'weight x cell volume; voxel: centres of ppc^ndim equal sub-cells', &
@@ -97,14 +101,25 @@ contains
         empm_param('velocity_sine_phase', PARAM_REAL, 'rad', 'phi in the same', default='0', &
           lo=-LMAX, hi=LMAX), &
         empm_param('stress', PARAM_REAL, 'Pa', 'uniform initial Cauchy stress, Voigt order '// &
-          'xx, yy, zz, yz, xz, xy', default='0', count=6, lo=-1.0e30_wp, hi=1.0e30_wp)]
+          'xx, yy, zz, yz, xz, xy', default='0', count=6, lo=-1.0e30_wp, hi=1.0e30_wp), &
+        empm_param('name', PARAM_STR, '-', 'body label (unique), referenced by &traction '// &
+          'body', optional=.true.), &
+        empm_param('geostatic', PARAM_LOGICAL, '-', 'initial stress from the overburden '// &
+          'under the final gravity: sigma_v = -rho |g| depth, sigma_h = k0 sigma_v (instead '// &
+          'of `stress`)', default='.false.'), &
+        empm_param('k0', PARAM_REAL, '-', 'lateral earth pressure coefficient K0 of the '// &
+          'geostatic stress (required with geostatic)', lo=0.0_wp, hi=100.0_wp, &
+          optional=.true.)]
     case ('shape')
       p = [empm_param('family', PARAM_STR, '-', 'shape-function family (see the families '// &
         'below), or an identifier that also sets tagged parameters, e.g. ''lme_g0.8''', &
         default='''linear''')]
     case ('integrator')
       p = [empm_param('scheme', PARAM_STR, '-', 'time integrator (see the schemes below)', &
-        default='''musl'''), empm_run_params()]
+        default='''musl'''), empm_run_params(), &
+        empm_param('damping', PARAM_REAL, '-', 'local non-viscous damping alpha: nodal force '// &
+          'f -= alpha |f| sign(v) (0: none; for reaching static equilibrium)', default='0', &
+          lo=0.0_wp, hi=1.0_wp, hi_open=.true.)]
     case ('loads')
       p = [ &
         empm_param('gravity', PARAM_REAL, 'm/s^2', 'gravity vector (final value)', &
@@ -123,7 +138,31 @@ contains
         empm_param('fix', PARAM_LOGICAL, '-', 'which velocity components are prescribed '// &
           '(at least one)', default='.false.', count=3), &
         empm_param('velocity', PARAM_REAL, 'm/s', 'prescribed velocity of the fixed components', &
-          default='0', count=3, lo=-LMAX, hi=LMAX)]
+          default='0', count=3, lo=-LMAX, hi=LMAX), &
+        empm_param('name', PARAM_STR, '-', 'record the reaction force of this node set as '// &
+          '/history/reaction/<name> (unique)', optional=.true.)]
+    case ('traction')
+      p = [ &
+        empm_param('name', PARAM_STR, '-', 'label (messages)', optional=.true.), &
+        empm_param('body', PARAM_STR, '-', 'a &particles name: load that body only '// &
+          '(default: every body)', optional=.true.), &
+        empm_param('lo', PARAM_REAL, 'm', 'lower corner of the box selecting the loaded '// &
+          'particles (the outer layer); its side on the face side is the loaded surface', &
+          count=3, lo=-LMAX, hi=LMAX), &
+        empm_param('hi', PARAM_REAL, 'm', 'upper corner of that box', count=3, lo=-LMAX, &
+          hi=LMAX), &
+        empm_param('face', PARAM_STR, '-', 'the loaded face of each particle, its outward '// &
+          'normal: +x, -x, +y, -y, +z or -z', choices='+x -x +y -y +z -z'), &
+        empm_param('pressure', PARAM_REAL, 'Pa', 'normal pressure, positive pushing into the '// &
+          'body (traction = -pressure n); give pressure or traction', lo=-1.0e30_wp, &
+          hi=1.0e30_wp, optional=.true.), &
+        empm_param('traction', PARAM_REAL, 'Pa', 'traction vector (force per area); give '// &
+          'pressure or traction', count=3, lo=-1.0e30_wp, hi=1.0e30_wp, optional=.true.), &
+        empm_param('ramp', PARAM_STR, '-', 'none (constant), linear (0 at t = 0 to the full '// &
+          'value at ramp_time) or sine (as &loads ramp: full value at ramp_time/2)', &
+          default='''none''', choices='none linear sine'), &
+        empm_param('ramp_time', PARAM_REAL, 's', 'ramp time (required with a ramp)', &
+          lo=0.0_wp, lo_open=.true., hi=LMAX, optional=.true.)]
     case ('probe')
       p = [ &
         empm_param('name', PARAM_STR, '-', 'probe name (HDF5 group /probes/<name>)'), &
@@ -152,8 +191,8 @@ contains
     character(len=:), allocatable :: s                      !! Markdown
     character(len=*), parameter :: NL = new_line('a')
     type(empm_registry_t) :: reg
-    character(len=16), parameter :: ORDER(9) = [character(len=16) :: 'grid', 'material', &
-      'particles', 'shape', 'integrator', 'loads', 'boundary', 'probe', 'output']
+    character(len=16), parameter :: ORDER(10) = [character(len=16) :: 'grid', 'material', &
+      'particles', 'shape', 'integrator', 'loads', 'traction', 'boundary', 'probe', 'output']
     integer :: k
     if (present(registry)) then
       reg = registry
@@ -216,7 +255,12 @@ contains
     if (e%code == EMPM_OK) call read_particles(path, gs, cs, e)
     if (e%code == EMPM_OK) call read_integrator(path, gs, cs, ov, reg, e)
     if (e%code == EMPM_OK) call read_loads(gs, cs, e)
+    if (e%code == EMPM_OK) call apply_geostatic(gs, cs, e)
     if (e%code == EMPM_OK) call read_boundaries(gs, cs, e)
+    if (e%code == EMPM_OK) call read_tractions(gs, cs, e)
+    if (e%code == EMPM_OK) cs%model%track = cs%integ%damping > 0.0_wp .or. &
+      any(cs%body_k0 >= 0.0_wp) .or. cs%model%loads%ntraction() > 0 .or. &
+      cs%model%nodes%nset > 0
     if (e%code == EMPM_OK) call read_probes(gs, cs, e)
     if (e%code == EMPM_OK) call read_output(path, gs, cs, e)
     if (e%code == EMPM_OK) call check_initial_basis(path, cs, e)
@@ -421,15 +465,48 @@ contains
     real(wp) :: lo(3), hi(3), center(3), radius, velocity(3), amp(3), wavenumber(3), phase, &
                 stress(6)
     integer :: ppc, info, nbody, imat, i, geom, place, nadded, p0, q, nd, k, n, nlo, nhi, nc
+    integer(int64) :: nest
     type(empm_body_points_t) :: body
+    character(len=:), allocatable :: bname
+    logical :: geostatic
+    real(wp) :: k0
     allocate(p, source=empm_input_group_params('particles'))
     nd = cs%model%grid%ndim
     nbody = 0
+    allocate(cs%body_name(0), cs%body_first(0), cs%body_last(0), cs%body_k0(0), &
+      cs%body_group(0), cs%body_lo(3, 0), cs%body_hi(3, 0), cs%body_box(0))
+    nest = 0
     do k = 1, size(gs)
       if (gs(k)%name /= 'particles') cycle
       g = gs(k)
       nbody = nbody + 1
       call g%check_keys(p, e)
+      bname = ''; geostatic = .false.; k0 = -1.0_wp
+      call g%get(p(15), bname, e)
+      call g%get(p(16), geostatic, e)
+      call g%get(p(17), k0, e)
+      if (e%code /= EMPM_OK) return
+      if (g%has('name')) then
+        if (.not. valid_name(bname)) then
+          call g%fail(e, 'name', 'expected letters, digits, ''_'', ''.'' or ''-'' (at most '// &
+            '64), got '''//bname//''''); return
+        end if
+        if (any(cs%body_name == bname)) then
+          call g%fail(e, 'name', 'duplicate body name '''//bname//''''); return
+        end if
+      end if
+      if (geostatic .and. .not. g%has('k0')) then
+        call g%fail(e, 'k0', 'required with geostatic = .true.: K0 = sigma_h/sigma_v (body '// &
+          str(nbody)//')'); return
+      end if
+      if (geostatic .and. g%has('stress')) then
+        call g%fail(e, 'stress', 'give geostatic or stress, not both (body '//str(nbody)//')')
+        return
+      end if
+      if (.not. geostatic) k0 = -1.0_wp
+      cs%body_name = [character(len=64) :: cs%body_name, bname]
+      cs%body_first = [cs%body_first, cs%model%pts%np + 1]
+      cs%body_k0 = [cs%body_k0, k0]; cs%body_group = [cs%body_group, k]
       material = ''; geometry = 'box'; placement = 'gauss'; ppc = 2; file = ''
       lo = 0.0_wp; hi = 0.0_wp; center = 0.0_wp; radius = 0.0_wp
       velocity = 0.0_wp; amp = 0.0_wp; wavenumber = 0.0_wp; phase = 0.0_wp; stress = 0.0_wp
@@ -448,6 +525,9 @@ contains
       call g%get(p(13), phase, e)
       call g%get(p(14), stress, n, e)
       if (e%code /= EMPM_OK) return
+      cs%body_box = [cs%body_box, geometry == 'box' .or. geometry == 'interval']
+      cs%body_lo = reshape([cs%body_lo, lo], [3, nbody])
+      cs%body_hi = reshape([cs%body_hi, hi], [3, nbody])
       imat = 0
       do i = 1, size(cs%model%mats)
         if (cs%model%mats(i)%label == material) imat = i
@@ -464,6 +544,11 @@ contains
       case ('file')
         call read_file_body()
         if (e%code /= EMPM_OK) return
+        if (geostatic .and. body%has_stress) then
+          call g%fail(e, 'geostatic', 'the file '''//file//''' gives stresses: give them '// &
+            'there or use geostatic, not both (body '//str(nbody)//')'); return
+        end if
+        cs%body_last = [cs%body_last, cs%model%pts%np]
         cycle
       case ('box', 'interval')
         geom = GEOM_BOX
@@ -488,6 +573,10 @@ contains
         end if
       end select
       place = merge(PLACE_GAUSS, PLACE_VOXEL, placement == 'gauss')
+      ! Refuse up front a body set whose particles would not fit in memory.
+      nest = nest + estimate_particles(cs%model%grid, geom, lo, hi, center, radius, ppc)
+      call check_particle_memory(g, cs, nest, e)
+      if (e%code /= EMPM_OK) return
       p0 = cs%model%pts%np
       call empm_fill(cs%model%pts, cs%model%grid, geom, lo, hi, center, radius, ppc, place, &
         cs%model%mats(imat)%model%rho0, imat, nadded, info)
@@ -502,6 +591,7 @@ contains
         end associate
         cs%model%pts%stress(:, q) = stress
       end do
+      cs%body_last = [cs%body_last, cs%model%pts%np]
     end do
     if (nbody == 0) call missing_group(path, 'particles', e)
 
@@ -566,6 +656,80 @@ contains
     end subroutine read_file_body
   end subroutine read_particles
 
+  ! Particles a box or disk/ball body gets at most: the cells its bounding box overlaps (within
+  ! the grid) times ppc per direction, times the disk's (π/4) or ball's (π/6) share of its
+  ! bounding square or cube. 64-bit: the product exceeds 2^31 for large cases.
+  function estimate_particles(grid, geom, lo, hi, center, radius, ppc) result(n)
+    use empm_grid, only: empm_grid_t
+    type(empm_grid_t), intent(in) :: grid
+    integer, intent(in) :: geom, ppc
+    real(wp), intent(in) :: lo(3), hi(3), center(3), radius
+    integer(int64) :: n
+    real(wp) :: a(3), b(3), top(3), cells, share
+    integer :: d, nd
+    nd = grid%ndim
+    top = grid%upper()
+    if (geom == GEOM_BOX) then
+      a = lo; b = hi; share = 1.0_wp
+    else
+      a = center - radius; b = center + radius
+      share = merge(acos(-1.0_wp) / 4.0_wp, acos(-1.0_wp) / 6.0_wp, nd == 2)
+    end if
+    cells = 1.0_wp
+    do d = 1, nd
+      a(d) = max(a(d), grid%origin(d)); b(d) = min(b(d), top(d))
+      if (b(d) <= a(d)) then
+        n = 0; return
+      end if
+      cells = cells * min(real(grid%ncell(d), wp), real(ceiling((b(d) - a(d)) / grid%h(d)), wp) &
+        + 1.0_wp)
+    end do
+    n = int(min(share * cells * real(ppc, wp)**nd, 9.0e18_wp), int64)
+  end function estimate_particles
+
+  ! The memory `np` particles need with the nodes (estimate): per particle its storage
+  ! (positions, velocities, accelerations, reference positions, domain half-lengths and LME
+  ! multipliers: 7 ndim values; masses, volumes, densities: 4; stress, strain: 12; F: 9; the
+  ! state variables; the material index), the solver's copy of the last good state (as much
+  ! again), the shape-function basis (max_nodes node indices, values and ndim gradients) and
+  ! scratch; refused (key ppc) when above the machine's physical memory.
+  subroutine check_particle_memory(g, cs, np, e)
+    type(empm_group_t), intent(in) :: g
+    type(empm_case_t), intent(in) :: cs
+    integer(int64), intent(in) :: np
+    type(empm_error_t), intent(inout) :: e
+    integer(int64) :: per, maxn, nnode, bytes, mem, nstate
+    integer :: nd, im
+    nd = cs%model%grid%ndim
+    nstate = 0
+    do im = 1, size(cs%model%mats)
+      nstate = max(nstate, int(cs%model%mats(im)%model%nstate(), int64))
+    end do
+    maxn = cs%model%shape%max_nodes(cs%model%grid)
+    per = 2_int64 * (8_int64 * (7_int64 * nd + 25_int64 + nstate) + 4_int64) + &
+      maxn * (4_int64 + 8_int64 + 8_int64 * nd) + 4_int64 + 8_int64 * (2_int64 * nd + 1_int64)
+    nnode = product(int(cs%model%grid%ncell(1:nd), int64) + 1_int64)
+    bytes = np * per + nnode * (8_int64 + 52_int64 * nd)
+    mem = empm_physical_memory()
+    if (np > int(huge(1), int64)) then
+      call g%fail(e, 'ppc', 'the bodies would have about '//i64(np)// &
+        ' particles, more than '//str(huge(1))//' (particle numbers are default integers)')
+    else if (mem > 0 .and. bytes > mem) then
+      call g%fail(e, 'ppc', 'the bodies would have about '//i64(np)// &
+        ' particles, which with the grid need about '//str_short(real(bytes, wp) / 2.0_wp**30)// &
+        ' GiB ('//i64(bytes)//' bytes), more than this machine''s '// &
+        str_short(real(mem, wp) / 2.0_wp**30)//' GiB ('//i64(mem)//' bytes)')
+    end if
+  contains
+    pure function i64(v) result(t)
+      integer(int64), intent(in) :: v
+      character(len=:), allocatable :: t
+      character(len=24) :: b
+      write(b, '(i0)') v
+      t = trim(b)
+    end function i64
+  end subroutine check_particle_memory
+
   subroutine read_integrator(path, gs, cs, ov, reg, e)
     character(len=*), intent(in) :: path
     type(empm_group_t), intent(in) :: gs(:)
@@ -576,7 +740,7 @@ contains
     type(empm_param_t), allocatable :: p(:)
     type(empm_group_t) :: g
     character(len=:), allocatable :: scheme
-    real(wp) :: cfl, dt, t_end
+    real(wp) :: cfl, dt, t_end, damping
     integer :: max_steps
     if (first(gs, 'integrator') == 0) then
       call missing_group(path, 'integrator', e); return
@@ -594,6 +758,8 @@ contains
     call g%get(p(3), cfl, e)
     call g%get(p(4), dt, e)
     call g%get(p(5), max_steps, e)
+    damping = 0.0_wp
+    call g%get(p(6), damping, e)
     if (e%code /= EMPM_OK) return
     ! Exact override values (their text form above is for validation only).
     if (ov%cfl > 0.0_wp) cfl = ov%cfl
@@ -602,6 +768,7 @@ contains
     call reg%create_integrator(scheme, cs%integ, e, g, p)
     if (e%code /= EMPM_OK) return
     cs%scheme_name = cs%integ%name()
+    cs%integ%damping = damping
     cs%run%t_end = t_end; cs%run%cfl = cfl; cs%run%dt = dt; cs%run%max_steps = max_steps
   end subroutine read_integrator
 
@@ -646,6 +813,7 @@ contains
     real(wp) :: lo(3), hi(3), velocity(3)
     logical :: fix(3)
     integer :: nb, nsel, nd, k, nlo, nhi, n
+    character(len=:), allocatable :: name
     allocate(p, source=empm_input_group_params('boundary'))
     nd = cs%model%grid%ndim
     call cs%model%nodes%alloc(cs%model%grid)
@@ -660,7 +828,18 @@ contains
       call g%get(p(2), hi, nhi, e)
       call g%get(p(3), fix, n, e)
       call g%get(p(4), velocity, n, e)
+      name = ''
+      call g%get(p(5), name, e)
       if (e%code /= EMPM_OK) return
+      if (g%has('name')) then
+        if (.not. valid_name(name)) then
+          call g%fail(e, 'name', 'expected letters, digits, ''_'', ''.'' or ''-'' (at most '// &
+            '64), got '''//name//''''); return
+        end if
+        if (any(cs%model%nodes%set_name(1:cs%model%nodes%nset) == name)) then
+          call g%fail(e, 'name', 'duplicate boundary name '''//name//''''); return
+        end if
+      end if
       if (nlo < nd .or. nhi < nd) then
         call g%fail(e, merge('lo', 'hi', nlo < nd), 'required: the box selecting the nodes, '// &
           str(nd)//' coordinates each of lo and hi [m] (boundary '//str(nb)//')'); return
@@ -669,13 +848,184 @@ contains
         call g%fail(e, 'fix', 'expected at least one .true. component (boundary '//str(nb)//')')
         return
       end if
-      call cs%model%nodes%fix_box(cs%model%grid, lo, hi, fix, velocity, nsel)
+      if (g%has('name')) then
+        call cs%model%nodes%fix_box(cs%model%grid, lo, hi, fix, velocity, nsel, name)
+      else
+        call cs%model%nodes%fix_box(cs%model%grid, lo, hi, fix, velocity, nsel)
+      end if
       if (nsel == 0) then
         call g%fail(e, 'lo', 'the box [lo, hi] selects no grid node (boundary '//str(nb)// &
           '): nodes lie at origin + i*h'); return
       end if
     end do
   end subroutine read_boundaries
+
+  !> A name that can be an HDF5 group: 1..64 of NAME_CHARS, not '.' or '..'.
+  pure logical function valid_name(name)
+    character(len=*), intent(in) :: name
+    valid_name = verify(name, NAME_CHARS) == 0 .and. len(name) > 0 .and. len(name) <= 64 &
+      .and. name /= '.' .and. name /= '..'
+  end function valid_name
+
+  !> Geostatic bodies: their particles' stress from the overburden under the final gravity
+  !> ([[empm_geostatic_stress]]), once &particles and &loads are read.
+  subroutine apply_geostatic(gs, cs, e)
+    type(empm_group_t), intent(in) :: gs(:)
+    type(empm_case_t), intent(inout) :: cs
+    type(empm_error_t), intent(inout) :: e
+    type(empm_group_t) :: g
+    integer :: b, i0, i1, info, nd, a
+    real(wp) :: surf
+    nd = cs%model%grid%ndim
+    do b = 1, size(cs%body_k0)
+      if (cs%body_k0(b) < 0.0_wp) cycle
+      g = gs(cs%body_group(b))
+      i0 = cs%body_first(b); i1 = cs%body_last(b)
+      associate (pts => cs%model%pts, grid => cs%model%grid, gv => cs%model%loads%gravity)
+        if (cs%body_box(b) .and. count(gv(1:nd) /= 0.0_wp) == 1) then
+          ! A box's top is known: its upper (lower, for g > 0) side along g.
+          a = findloc(gv(1:nd) /= 0.0_wp, .true., dim=1)
+          surf = merge(cs%body_hi(a, b), -cs%body_lo(a, b), gv(a) < 0.0_wp)
+          call empm_geostatic_stress(nd, grid%origin, grid%h, pts%x(:, i0:i1), &
+            pts%lp(:, i0:i1), pts%rho(i0:i1), gv, cs%body_k0(b), pts%stress(:, i0:i1), info, &
+            surface=surf)
+        else
+          call empm_geostatic_stress(nd, grid%origin, grid%h, pts%x(:, i0:i1), &
+            pts%lp(:, i0:i1), pts%rho(i0:i1), gv, cs%body_k0(b), pts%stress(:, i0:i1), info)
+        end if
+      end associate
+      if (info == 1) then
+        call g%fail(e, 'geostatic', 'needs a non-zero &loads gravity along one grid axis '// &
+          '(the vertical) (body '//str(b)//')'); return
+      else if (info /= 0) then
+        call g%fail(e, 'geostatic', 'the body spans more than 1e8 grid columns (body '// &
+          str(b)//')'); return
+      end if
+    end do
+  end subroutine apply_geostatic
+
+  !> &traction groups: the particles of the body (or of every body) inside the box, their face
+  !> areas, the traction vector and its ramp.
+  subroutine read_tractions(gs, cs, e)
+    type(empm_group_t), intent(in) :: gs(:)
+    type(empm_case_t), intent(inout) :: cs
+    type(empm_error_t), intent(inout) :: e
+    type(empm_param_t), allocatable :: p(:)
+    type(empm_group_t) :: g
+    type(empm_traction_t), allocatable :: trs(:)
+    character(len=:), allocatable :: name, body, face, ramp
+    real(wp) :: lo(3), hi(3), pressure, trac(3), ramp_time, tol, plane
+    integer :: k, nt, nd, nlo, nhi, n, ib, i0, i1, q, ax, d, cnt
+    allocate(p, source=empm_input_group_params('traction'))
+    nd = cs%model%grid%ndim
+    tol = 1.0e-9_wp * cs%model%grid%hmin()
+    allocate(trs(0))
+    nt = 0
+    do k = 1, size(gs)
+      if (gs(k)%name /= 'traction') cycle
+      g = gs(k)
+      nt = nt + 1
+      call g%check_keys(p, e)
+      name = ''; body = ''; face = ''; ramp = 'none'
+      lo = 0.0_wp; hi = 0.0_wp; pressure = 0.0_wp; trac = 0.0_wp; ramp_time = 0.0_wp
+      call g%get(p(1), name, e)
+      call g%get(p(2), body, e)
+      call g%get(p(3), lo, nlo, e)
+      call g%get(p(4), hi, nhi, e)
+      call g%get(p(5), face, e)
+      call g%get(p(6), pressure, e)
+      call g%get(p(7), trac, n, e)
+      call g%get(p(8), ramp, e)
+      call g%get(p(9), ramp_time, e)
+      if (e%code /= EMPM_OK) return
+      if (.not. g%has('name')) name = 'traction '//str(nt)
+      if (nlo < nd .or. nhi < nd) then
+        call g%fail(e, merge('lo', 'hi', nlo < nd), 'required: the box selecting the loaded '// &
+          'particles, '//str(nd)//' coordinates each of lo and hi [m] ('//name//')'); return
+      end if
+      if (.not. g%has('face')) then
+        call g%fail(e, 'face', 'required: the outward normal of the loaded face, one of '// &
+          '+x -x +y -y +z -z ('//name//')'); return
+      end if
+      ax = index('xyz', face(2:2))
+      if (ax > nd) then
+        call g%fail(e, 'face', 'expected an axis of the '//str(nd)//'D grid, got '''//face// &
+          ''' ('//name//')'); return
+      end if
+      if (g%has('pressure') .eqv. g%has('traction')) then
+        call g%fail(e, 'pressure', 'give exactly one of pressure and traction ('//name//')')
+        return
+      end if
+      if (ramp /= 'none' .and. .not. g%has('ramp_time')) then
+        call g%fail(e, 'ramp_time', 'required with ramp = '''//ramp//''': the ramp time [s] '// &
+          '> 0 ('//name//')'); return
+      end if
+      ib = 0
+      if (g%has('body')) then
+        do q = 1, size(cs%body_name)
+          if (trim(cs%body_name(q)) == body) ib = q
+        end do
+        if (ib == 0 .or. len(body) == 0) then
+          call g%fail(e, 'body', 'expected the name of a &particles group, got '''//body// &
+            ''' ('//name//')'); return
+        end if
+      end if
+      trs = [trs, empm_traction_t()]
+      associate (tr => trs(nt))
+        tr%name = name; tr%axis = ax; tr%side = merge(1, -1, face(1:1) == '+')
+        tr%traction = 0.0_wp
+        if (g%has('pressure')) then
+          tr%traction(ax) = -pressure * tr%side
+        else
+          tr%traction(1:nd) = trac(1:nd)
+        end if
+        select case (ramp)
+        case ('linear'); tr%ramp = RAMP_LINEAR
+        case ('sine'); tr%ramp = RAMP_SINE
+        case default; tr%ramp = RAMP_NONE
+        end select
+        tr%t_ramp = ramp_time
+        i0 = 1; i1 = cs%model%pts%np
+        if (ib > 0) then
+          i0 = cs%body_first(ib); i1 = cs%body_last(ib)
+        end if
+        associate (x => cs%model%pts%x)
+          cnt = 0
+          do q = i0, i1
+            if (all(x(1:nd, q) >= lo(1:nd) - tol .and. x(1:nd, q) <= hi(1:nd) + tol)) cnt = cnt + 1
+          end do
+          if (cnt == 0) then
+            call g%fail(e, 'lo', 'the box [lo, hi] selects no particle ('//name//')'); return
+          end if
+          allocate(tr%part(cnt), tr%area(cnt), tr%offset(cnt))
+          ! The loaded plane is the box's outer side; every particle must lie within its own
+          ! size 2 lp of it (the outer layer only).
+          plane = merge(hi(ax), lo(ax), tr%side > 0)
+          cnt = 0
+          do q = i0, i1
+            if (all(x(1:nd, q) >= lo(1:nd) - tol .and. x(1:nd, q) <= hi(1:nd) + tol)) then
+              cnt = cnt + 1; tr%part(cnt) = q
+              tr%offset(cnt) = max(tr%side * (plane - x(ax, q)), 0.0_wp)
+              if (tr%offset(cnt) > 2.0_wp * cs%model%pts%lp(ax, q) + tol) then
+                call g%fail(e, merge('lo', 'hi', tr%side > 0), 'particle '//str(q)// &
+                  ' lies '//str(tr%offset(cnt))//' m inside the loaded face (the box''s '// &
+                  merge('upper', 'lower', tr%side > 0)//' side along '//face(2:2)// &
+                  '), more than its size '//str(2.0_wp * cs%model%pts%lp(ax, q))// &
+                  ': the box must select the outer layer of particles only ('//name//')')
+                return
+              end if
+              ! Face area: the domain's side lengths across the normal (per unit thickness).
+              tr%area(cnt) = 1.0_wp
+              do d = 1, nd
+                if (d /= ax) tr%area(cnt) = tr%area(cnt) * 2.0_wp * cs%model%pts%lp(d, q)
+              end do
+            end if
+          end do
+        end associate
+      end associate
+    end do
+    call move_alloc(trs, cs%model%loads%tractions)
+  end subroutine read_tractions
 
   subroutine read_probes(gs, cs, e)
     type(empm_group_t), intent(in) :: gs(:)
@@ -709,8 +1059,7 @@ contains
         call g%fail(e, 'name', 'duplicate probe name '''//name//''''); return
       end if
       ! The name becomes an HDF5 group: a '/' would make it a path.
-      if (verify(name, 'abcdefghijklmnopqrstuvwxyzABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789_.-') > 0 &
-          .or. len(name) == 0 .or. name == '.' .or. name == '..') then
+      if (.not. valid_name(name)) then
         call g%fail(e, 'name', 'expected letters, digits, ''_'', ''.'' or ''-'', got '''// &
           name//''''); return
       end if

@@ -1,8 +1,15 @@
 !> Writes a run to HDF5 (layout in docs/output.md) and an XDMF file beside it for ParaView.
 !>
-!> The file is written under a temporary name (`OUT.partial`) and renamed when complete, so an
-!> interrupted run never leaves a file that looks complete. A run stopped by a guard is still
-!> written, with the last good state and the root attribute `complete = 0`.
+!> The file is written under a temporary name unique to the writer (`OUT.<pid>-<n>.partial`,
+!> created exclusively) and renamed when complete, so an interrupted run never leaves a file
+!> that looks complete and two writers never share a partial file. A run stopped by a guard is
+!> still written, with the last good state and the root attribute `complete = 0`. HDF5's own
+!> error stack is not printed: a failed write is one message with the system's reason, and
+!> every object is closed (no partial file, no crash at exit).
+!>
+!> [[empm_output_claim]] checks an output path before a run (it must be a regular file or
+!> absent) and takes its lock (`OUT.lock`, holding the pid), so that a second run writing the
+!> same file is refused at its start; [[empm_output_release]] removes the lock.
 !>
 !> The materials' state variables are written by name (`state/<name>`, one value per particle),
 !> NaN for the particles whose material does not declare that name.
@@ -16,11 +23,14 @@
 !> so no 6-value order reads right in both (docs/paraview.md).
 module empm_output
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
-  use hdf5, only: h5open_f, h5fcreate_f, h5fclose_f, H5F_ACC_TRUNC_F
+  use hdf5, only: h5open_f, h5fcreate_f, h5fclose_f, H5F_ACC_EXCL_F, h5eset_auto_f, &
+    h5dont_atexit_f
   use empm_kinds, only: wp
   use empm_h5, only: hid_t, h5_group, h5_close_group, h5_write, h5_attr
-  use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO
+  use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO, EMPM_ERR_INPUT
   use empm_files, only: empm_rename, empm_remove
+  use empm_posix, only: empm_getpid, empm_process_alive, empm_path_kind, empm_errno, &
+    empm_errno_text, PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY
   use empm_version_info, only: empm_version
   use empm_model, only: empm_model_t
   use empm_material, only: STATE_NAME_LEN
@@ -29,6 +39,7 @@ module empm_output
   implicit none
   private
   public :: empm_write_results, empm_output_meta_t, empm_xdmf_path
+  public :: empm_output_claim, empm_output_release, empm_partial_name
 
   !> Descriptive metadata stored as root attributes.
   type :: empm_output_meta_t
@@ -52,18 +63,26 @@ contains
     character(len=*), intent(in) :: status             !! '' or the message that stopped it
     type(empm_error_t), intent(out), optional :: err   !! error, if present
     integer(hid_t) :: fid, g, gs, gp
-    integer :: ierr, e, k, info, n
-    character(len=:), allocatable :: tmp, xmf
+    integer :: ierr, e, k, info, n, oserr
+    character(len=:), allocatable :: tmp, xmf, xtmp
     character(len=16) :: sname
     character(len=STATE_NAME_LEN), allocatable :: snames(:)
     integer, allocatable :: scol(:,:)
-    tmp = path//'.partial'
+    tmp = empm_partial_name(path)
     ierr = 0
     call state_columns(model, snames, scol)
+    ! A file whose close failed (its flush: disk full) stays open inside HDF5, and closing it
+    ! again, as HDF5's clean-up at exit does, crashes (HDF5 1.10): no clean-up at exit (our
+    ! files are all closed explicitly). Effective only before the library's first use.
+    call h5dont_atexit_f(e)
     call h5open_f(e)
-    call h5fcreate_f(tmp, H5F_ACC_TRUNC_F, fid, e)
+    ! Failures are reported once, by us, with the system's reason: not HDF5's error stacks.
+    call h5eset_auto_f(0, e)
+    call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e)
     if (e /= 0) then
-      call empm_raise(EMPM_ERR_IO, path//': cannot create HDF5 file '//tmp, err); return
+      oserr = empm_errno()
+      call empm_raise(EMPM_ERR_IO, path//': cannot create HDF5 file '//tmp//': '// &
+        empm_errno_text(oserr), err); return
     end if
     call h5_attr(fid, 'empm_version', empm_version(), ierr)
     call h5_attr(fid, 'complete', merge(1, 0, complete), ierr)
@@ -134,6 +153,20 @@ contains
     call h5_write(g, 'kinetic_energy', hist%kinetic(1:hist%nt), ierr)
     call h5_write(g, 'strain_energy', hist%strain(1:hist%nt), ierr)
     call h5_write(g, 'gravity_potential', hist%gravity(1:hist%nt), ierr)
+    if (hist%tracked) then
+      ! Residual and reactions (docs/output.md), recorded when the model tracks them.
+      call h5_write(g, 'residual', hist%residual(1:hist%nt), ierr)
+      if (hist%nset > 0) then
+        call h5_group(g, 'reaction', gs, ierr)
+        do k = 1, hist%nset
+          call h5_group(gs, trim(hist%set_name(k)), gp, ierr)
+          call h5_write(gp, 'force', hist%reaction(:, k, 1:hist%nt), ierr)
+          call h5_write(gp, 'displacement', hist%set_disp(:, k, 1:hist%nt), ierr)
+          call h5_close_group(gp, ierr)
+        end do
+        call h5_close_group(gs, ierr)
+      end if
+    end if
     call h5_close_group(g, ierr)
 
     call h5_group(fid, 'probes', gs, ierr)
@@ -148,26 +181,52 @@ contains
     end do
     call h5_close_group(gs, ierr)
 
+    ! errno now is the reason of a failed write (HDF5 keeps it); a failed close sets it too.
+    ! Every group, dataset and attribute is closed by now (the helpers close what they open
+    ! even on failure): only the file is left.
+    oserr = 0
+    if (ierr /= 0) oserr = empm_errno()
     call h5fclose_f(fid, e)
-    if (e /= 0) ierr = e
+    if (e /= 0) then
+      if (oserr == 0) oserr = empm_errno()
+      ierr = e
+    end if
     if (ierr /= 0) then
       info = empm_remove(tmp)
-      call empm_raise(EMPM_ERR_IO, path//': writing the HDF5 output failed', err); return
+      call empm_raise(EMPM_ERR_IO, path//': writing the HDF5 output '//tmp//' failed: '// &
+        os_reason(oserr), err); return
     end if
     xmf = empm_xdmf_path(path)
-    call write_xdmf(xmf//'.partial', basename(path), model, hist, snames, ierr)
+    xtmp = empm_partial_name(xmf)
+    call write_xdmf(xtmp, basename(path), model, hist, snames, ierr, oserr)
     if (ierr /= 0) then
-      info = empm_remove(tmp); info = empm_remove(xmf//'.partial')
-      call empm_raise(EMPM_ERR_IO, path//': cannot write the XDMF file '//xmf//'.partial', err)
+      info = empm_remove(tmp); info = empm_remove(xtmp)
+      call empm_raise(EMPM_ERR_IO, path//': cannot write the XDMF file '//xtmp//': '// &
+        os_reason(oserr), err)
       return
     end if
     if (empm_rename(tmp, path) /= 0) then
-      info = empm_remove(xmf//'.partial')
-      call empm_raise(EMPM_ERR_IO, path//': cannot rename '//tmp//' to '//path, err); return
+      oserr = empm_errno()
+      info = empm_remove(tmp); info = empm_remove(xtmp)
+      call empm_raise(EMPM_ERR_IO, path//': cannot rename '//tmp//' to '//path//': '// &
+        os_reason(oserr), err); return
     end if
-    if (empm_rename(xmf//'.partial', xmf) /= 0) then
-      call empm_raise(EMPM_ERR_IO, path//': cannot rename '//xmf//'.partial to '//xmf, err)
+    if (empm_rename(xtmp, xmf) /= 0) then
+      oserr = empm_errno()
+      info = empm_remove(xtmp)
+      call empm_raise(EMPM_ERR_IO, path//': cannot rename '//xtmp//' to '//xmf//': '// &
+        os_reason(oserr), err)
     end if
+  contains
+    function os_reason(code) result(r)
+      integer, intent(in) :: code
+      character(len=:), allocatable :: r
+      if (code > 0) then
+        r = empm_errno_text(code)
+      else
+        r = 'the HDF5 library reports an error'
+      end if
+    end function os_reason
   end subroutine empm_write_results
 
   subroutine write_state(g, pts, ierr)
@@ -188,6 +247,102 @@ contains
     call h5_write(g, 'density', pts%rho(1:n), ierr)
     call h5_write(g, 'material', pts%mat(1:n), ierr)
   end subroutine write_state
+
+  !> The temporary name a file is written under before it is renamed to `path`: unique to
+  !> this process and call (`path.<pid>-<n>.partial`), so that concurrent writers never share
+  !> one.
+  function empm_partial_name(path) result(tmp)
+    character(len=*), intent(in) :: path     !! final name
+    character(len=:), allocatable :: tmp     !! temporary name beside it
+    integer, save :: counter = 0
+    integer :: n
+    !$omp atomic capture
+    counter = counter + 1
+    n = counter
+    !$omp end atomic
+    tmp = path//'.'//itoa(empm_getpid())//'-'//itoa(n)//'.partial'
+  end function empm_partial_name
+
+  !> Before a run: check that `path` can be an output (absent or a regular file; a folder or a
+  !> device is refused, EMPM_ERR_INPUT naming it) and take its lock `path.lock` (EMPM_ERR_IO
+  !> when another live process holds it; a lock left by a killed run is taken over). On
+  !> success the caller owns the lock and calls [[empm_output_release]] at the end.
+  subroutine empm_output_claim(path, err)
+    character(len=*), intent(in) :: path         !! output HDF5 file
+    type(empm_error_t), intent(out) :: err       !! error, code 0 on success
+    character(len=:), allocatable :: lock, xmf
+    integer :: u, ios, pid, attempt, info
+    xmf = empm_xdmf_path(path)
+    select case (empm_path_kind(path))
+    case (PATH_MISSING, PATH_REGULAR)
+    case (PATH_DIRECTORY)
+      call err%set(EMPM_ERR_INPUT, path//': the output exists and is a folder, not a file'); return
+    case default
+      call err%set(EMPM_ERR_INPUT, path//': the output exists and is not a regular file '// &
+        '(a device, FIFO or socket); refusing to replace it'); return
+    end select
+    if (empm_path_kind(xmf) /= PATH_MISSING .and. empm_path_kind(xmf) /= PATH_REGULAR) then
+      call err%set(EMPM_ERR_INPUT, path//': its XDMF file '//xmf// &
+        ' exists and is not a regular file; refusing to replace it'); return
+    end if
+    lock = path//'.lock'
+    do attempt = 1, 2
+      ! status 'new' creates the file exclusively (O_EXCL): one process wins.
+      open(newunit=u, file=lock, status='new', action='write', iostat=ios)
+      if (ios == 0) then
+        write(u, '(i0)', iostat=ios) empm_getpid()
+        close(u)
+        return
+      end if
+      pid = lock_owner(lock)
+      if (pid < 0 .and. empm_path_kind(lock) == PATH_MISSING) then
+        ! The folder is missing or not writable: the same test as for the output itself.
+        call err%set(EMPM_ERR_IO, path//': cannot create the lock file '//lock//': '// &
+          empm_errno_text(empm_errno())); return
+      end if
+      if (pid > 0 .and. empm_process_alive(pid)) then
+        call err%set(EMPM_ERR_IO, path//': another run (process '//itoa(pid)// &
+          ') is writing this file (lock '//lock//'); wait for it or choose another -o'); return
+      end if
+      ! Left by a killed run (or being written this instant: then the retry finds it again).
+      if (pid /= 0) info = empm_remove(lock)
+    end do
+    call err%set(EMPM_ERR_IO, path//': cannot take the lock '//lock// &
+      ' (remove it if no run is writing '//path//')')
+  contains
+    integer function lock_owner(f) result(p)
+      character(len=*), intent(in) :: f
+      integer :: v, ios2
+      p = -1
+      open(newunit=v, file=f, status='old', action='read', iostat=ios2)
+      if (ios2 /= 0) return
+      p = 0
+      read(v, *, iostat=ios2) p
+      if (ios2 /= 0) p = 0
+      close(v)
+      ! p = 0: just created by another process that has not written its pid yet.
+    end function lock_owner
+  end subroutine empm_output_claim
+
+  !> Release the lock taken by [[empm_output_claim]] (remove `path.lock` if this process
+  !> holds it).
+  subroutine empm_output_release(path)
+    character(len=*), intent(in) :: path !! output HDF5 file
+    integer :: u, ios, pid, info
+    open(newunit=u, file=path//'.lock', status='old', action='read', iostat=ios)
+    if (ios /= 0) return
+    read(u, *, iostat=ios) pid
+    close(u)
+    if (ios == 0 .and. pid == empm_getpid()) info = empm_remove(path//'.lock')
+  end subroutine empm_output_release
+
+  pure function itoa(i) result(s)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: s
+    character(len=24) :: b
+    write(b, '(i0)') i
+    s = trim(b)
+  end function itoa
 
   !> The state-variable names of all materials (each once, in material order) and, for name k
   !> and material m, the row `col(k, m)` of `pts%state` holding it (0: m does not declare it).
@@ -308,13 +463,14 @@ contains
   !> XDMF 2 temporal collection, one polyvertex grid per snapshot and the final state (unless
   !> the last snapshot is it), written to `xmf` (the caller renames it) with every write
   !> checked; `ierr` /= 0 on failure. `h5name` is the HDF5 file relative to the XDMF's folder.
-  subroutine write_xdmf(xmf, h5name, model, hist, snames, ierr)
+  subroutine write_xdmf(xmf, h5name, model, hist, snames, ierr, oserr)
     character(len=*), intent(in) :: xmf
     character(len=*), intent(in) :: h5name
     type(empm_model_t), intent(in) :: model
     type(empm_history_t), intent(in) :: hist
     character(len=*), intent(in) :: snames(:)
     integer, intent(inout) :: ierr
+    integer, intent(out) :: oserr
     character(len=*), parameter :: NL = new_line('a')
     character(len=:), allocatable :: doc
     integer :: u, k, ios
@@ -331,14 +487,24 @@ contains
     if (.not. final_frame) final_frame = hist%snap(hist%nsnap)%step /= model%step
     if (final_frame) call grid_entry(model%t, model%pts%np, '/final')
     doc = doc//'  </Grid>'//NL//' </Domain>'//NL//'</Xdmf>'
-    open(newunit=u, file=xmf, status='replace', action='write', iostat=ios)
+    oserr = 0
+    ! status 'new': created exclusively (the name is this writer's own).
+    open(newunit=u, file=xmf, status='new', action='write', iostat=ios)
     if (ios /= 0) then
-      ierr = 1; return
+      oserr = empm_errno(); ierr = 1; return
     end if
     write(u, '(a)', iostat=ios) doc
-    if (ios /= 0) ierr = 1
+    if (ios /= 0) then
+      oserr = empm_errno(); ierr = 1
+    end if
+    flush(u, iostat=ios)
+    if (ios /= 0 .and. ierr == 0) then
+      oserr = empm_errno(); ierr = 1
+    end if
     close(u, iostat=ios)
-    if (ios /= 0) ierr = 1
+    if (ios /= 0 .and. ierr == 0) then
+      oserr = empm_errno(); ierr = 1
+    end if
   contains
     subroutine grid_entry(t, np, grp)
       real(wp), intent(in) :: t

@@ -6,6 +6,7 @@ module empm_history
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, empm_raise_error, empm_alloc_error
   use empm_particles, only: empm_particles_t
+  use empm_model, only: empm_model_t
   implicit none
   private
   public :: empm_history_t, empm_snapshot_t
@@ -40,6 +41,15 @@ module empm_history
     real(wp), allocatable :: ps(:,:,:)       !! probe stresses (6, nprobe, nt)
     integer :: nsnap = 0                     !! snapshots taken
     type(empm_snapshot_t), allocatable :: snap(:) !! snapshots (nsnap used)
+    ! Recorded when the model tracks its residual (`model%track`), sized at the first sample.
+    logical :: tracked = .false.             !! the arrays below are in use
+    real(wp), allocatable :: residual(:)     !! ‖f_unbalanced‖/‖f_ext‖ of the last force
+                                             !! assembly (nt); −1 when no external load acts
+    integer :: nset = 0                      !! reaction sets (named &boundary groups)
+    character(len=64), allocatable :: set_name(:) !! their names (nset)
+    real(wp), allocatable :: reaction(:,:,:) !! reaction force of each set (ndim, nset, nt) [N]
+    real(wp), allocatable :: set_disp(:,:,:) !! prescribed displacement of each set, velocity × t
+                                             !! on its fixed components (ndim, nset, nt) [m]
   contains
     procedure :: init => history_init
     procedure :: add_sample => history_add_sample
@@ -66,6 +76,9 @@ contains
     if (allocated(self%t)) deallocate(self%t, self%kinetic, self%strain, self%gravity, &
       self%px, self%pv, self%ps, self%probe_name, self%probe_particle)
     if (allocated(self%snap)) deallocate(self%snap)
+    if (allocated(self%residual)) deallocate(self%residual)
+    if (allocated(self%set_name)) deallocate(self%set_name, self%reaction, self%set_disp)
+    self%tracked = .false.; self%nset = 0
     allocate(self%probe_name(n), self%probe_particle(n))
     self%probe_name = names; self%probe_particle = particles
     allocate(self%t(c), self%kinetic(c), self%strain(c), self%gravity(c), &
@@ -75,15 +88,27 @@ contains
       8_int64 * c * (4 + n * (2 * ndim + 6)), msg), err)
   end subroutine history_init
 
-  !> Append one sample. Storage grows geometrically when full (rare, amortised).
-  subroutine history_add_sample(self, t, ekin, estrain, egrav, pts)
+  !> Append one sample. Storage grows geometrically when full (rare, amortised). With `model`
+  !> tracking its residual, the residual and the reactions of its node sets are recorded too
+  !> (their arrays sized at the first such sample).
+  subroutine history_add_sample(self, t, ekin, estrain, egrav, pts, model)
     class(empm_history_t), intent(inout) :: self !! record
     real(wp), intent(in) :: t                    !! time [s]
     real(wp), intent(in) :: ekin                 !! kinetic energy [J]
     real(wp), intent(in) :: estrain              !! stored energy [J]
     real(wp), intent(in) :: egrav                !! gravitational potential [J]
     type(empm_particles_t), intent(in) :: pts    !! particles (probe values)
-    integer :: k, p
+    type(empm_model_t), intent(in), optional :: model !! model (residual, reactions)
+    integer :: k, p, nd
+    if (present(model)) then
+      ! Tracking starts with the first sample (a model tracked only later is not recorded).
+      if (model%track .and. .not. self%tracked .and. self%nt == 0) then
+        self%tracked = .true.; self%nset = model%nodes%nset; nd = model%grid%ndim
+        allocate(self%residual(size(self%t)), self%set_name(self%nset), &
+          self%reaction(nd, self%nset, size(self%t)), self%set_disp(nd, self%nset, size(self%t)))
+        self%set_name = model%nodes%set_name(1:self%nset)
+      end if
+    end if
     if (self%nt == size(self%t)) call grow(self)
     k = self%nt + 1; self%nt = k
     self%t(k) = t; self%kinetic(k) = ekin; self%strain(k) = estrain; self%gravity(k) = egrav
@@ -92,6 +117,13 @@ contains
       self%pv(:, p, k) = pts%v(:, self%probe_particle(p))
       self%ps(:, p, k) = pts%stress(:, self%probe_particle(p))
     end do
+    if (self%tracked .and. present(model)) then
+      self%residual(k) = model%residual
+      do p = 1, self%nset
+        self%reaction(:, p, k) = model%nodes%reaction(:, p)
+        self%set_disp(:, p, k) = model%nodes%set_vel(:, p) * t
+      end do
+    end if
   end subroutine history_add_sample
 
   subroutine grow(self)
@@ -109,6 +141,13 @@ contains
     call move_alloc(r3, self%pv)
     allocate(r3(6, self%nprobe, c)); r3(:, :, 1:n) = self%ps(:, :, 1:n)
     call move_alloc(r3, self%ps)
+    if (self%tracked) then
+      allocate(r1(c)); r1(1:n) = self%residual(1:n); call move_alloc(r1, self%residual)
+      allocate(r3(size(self%reaction, 1), self%nset, c))
+      r3(:, :, 1:n) = self%reaction(:, :, 1:n); call move_alloc(r3, self%reaction)
+      allocate(r3(size(self%set_disp, 1), self%nset, c))
+      r3(:, :, 1:n) = self%set_disp(:, :, 1:n); call move_alloc(r3, self%set_disp)
+    end if
   end subroutine grow
 
   !> Store a snapshot of the particle state, state variables included (ignored beyond the

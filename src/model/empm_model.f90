@@ -46,6 +46,11 @@ module empm_model
     integer, allocatable :: run_last(:)                 !! ... last particle of the run
     real(wp) :: t = 0.0_wp                              !! current time [s]
     integer :: step = 0                                 !! steps taken
+    logical :: track = .false.                          !! compute the residual (and the
+                                                        !! reactions) at every force assembly
+    real(wp) :: residual = -1.0_wp                      !! from the last assembly (with
+                                                        !! `track`): ‖f_unbalanced‖/‖f_ext‖,
+                                                        !! −1 when unknown or no load acts
   contains
     procedure :: finalize_setup => model_finalize_setup
   end type empm_model_t

@@ -45,6 +45,8 @@ module empm_solver
     real(wp) :: energy_initial = 0.0_wp !! total energy (kinetic + strain + gravity) at the start [J]
     real(wp) :: energy_final = 0.0_wp   !! total energy at the end (last good state) [J]
     real(wp) :: work_gravity = 0.0_wp   !! work of a time-varying gravity, −∫ Σ m ġ·x dt [J]
+    logical :: tracked = .false.        !! the model tracked its residual
+    real(wp) :: residual = -1.0_wp      !! its last value (model%residual)
                                         !! (trapezoidal per step): what the total energy
                                         !! gains from a gravity ramp
   end type empm_run_stats_t
@@ -151,7 +153,7 @@ contains
     if (allocated(cfg%snapshot_times)) nsnap = size(cfg%snapshot_times)
     isnap = 1
     call empm_energies(model, psi, ekin, estr, egrav)
-    call hist%add_sample(model%t, ekin, estr, egrav, model%pts)
+    call hist%add_sample(model%t, ekin, estr, egrav, model%pts, model)
     st%t_start = model%t; st%energy_initial = ekin + estr + egrav
     st%dt_min = huge(1.0_wp)
     call skip_past_snapshots()
@@ -201,7 +203,7 @@ contains
 
       if (mod(model%step, cfg%history_every) == 0 .or. model%t >= cfg%t_end) then
         call empm_energies(model, psi, ekin, estr, egrav)
-        call hist%add_sample(model%t, ekin, estr, egrav, model%pts)
+        call hist%add_sample(model%t, ekin, estr, egrav, model%pts, model)
       end if
       call skip_past_snapshots()
       if (show) call progress()
@@ -229,6 +231,7 @@ contains
       st%wall = real(clock - clock0, wp) / real(rate, wp)
       if (st%steps == 0) st%dt_min = 0.0_wp
       st%t_reached = model%t; st%ran = .true.
+      st%tracked = model%track; st%residual = model%residual
       call empm_energies(model, psi, ekin, estr, egrav)
       st%energy_final = ekin + estr + egrav
       if (present(stats)) stats = st
@@ -381,7 +384,8 @@ contains
   !> (drift -2.1E-06)`, with `, gravity ramp work W J` before the drift when gravity varies.
   !> The drift is (E_final − E_initial − W) / max(|E_initial|, |E_final|, |W|) of the total
   !> energy (kinetic + strain + gravity potential); work done by prescribed non-zero boundary
-  !> velocities is not subtracted and shows in it.
+  !> velocities is not subtracted and shows in it. A run that tracked its residual (model%track)
+  !> ends with `; residual R`, its last value.
   function empm_run_summary(st) result(s)
     type(empm_run_stats_t), intent(in) :: st !! statistics of a run
     character(len=:), allocatable :: s       !! the line (no trailing newline)
@@ -407,6 +411,10 @@ contains
       s = s//', gravity ramp work '//trim(adjustl(e0))//' J'
     end if
     s = s//' (drift '//trim(adjustl(drift))//')'
+    if (st%tracked) then
+      write(e0, '(es10.3)') st%residual
+      s = s//'; residual '//trim(adjustl(e0))
+    end if
   end function empm_run_summary
 
   pure function vec(x) result(s)

@@ -1,0 +1,144 @@
+!> Operating-system queries the output needs and Fortran does not offer (POSIX and Linux
+!> through C interoperability): the process id and whether a process is alive (output locks),
+!> the kind of an existing path (an output must be a regular file), the text of `errno` (the
+!> reason of a failed write) and ignoring SIGXFSZ (so that exceeding the file-size limit is a
+!> failed write, reported, not a killed process).
+module empm_posix
+  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_funptr, &
+    c_intptr_t, c_f_pointer, c_associated, c_int16_t
+  implicit none
+  private
+  public :: empm_getpid, empm_process_alive, empm_path_kind, empm_errno, empm_errno_text, &
+            empm_ignore_sigxfsz
+  public :: PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY, PATH_OTHER
+
+  integer, parameter :: PATH_MISSING = 0   !! nothing at the path (or it cannot be examined)
+  integer, parameter :: PATH_REGULAR = 1   !! a regular file (after following symbolic links)
+  integer, parameter :: PATH_DIRECTORY = 2 !! a folder
+  integer, parameter :: PATH_OTHER = 3     !! a device, FIFO or socket
+
+  interface
+    function c_getpid() bind(C, name='getpid') result(pid)
+      import :: c_int
+      integer(c_int) :: pid
+    end function c_getpid
+    function c_kill(pid, sig) bind(C, name='kill') result(r)
+      import :: c_int
+      integer(c_int), value :: pid, sig
+      integer(c_int) :: r
+    end function c_kill
+    function c_statx(dirfd, path, flags, mask, buf) bind(C, name='statx') result(r)
+      import :: c_int, c_char, c_int16_t
+      integer(c_int), value :: dirfd, flags, mask
+      character(kind=c_char), intent(in) :: path(*)
+      integer(c_int16_t), intent(out) :: buf(128)
+      integer(c_int) :: r
+    end function c_statx
+    function c_errno_location() bind(C, name='__errno_location') result(p)
+      import :: c_ptr
+      type(c_ptr) :: p
+    end function c_errno_location
+    function c_strerror(errnum) bind(C, name='strerror') result(p)
+      import :: c_int, c_ptr
+      integer(c_int), value :: errnum
+      type(c_ptr) :: p
+    end function c_strerror
+    function c_signal(sig, handler) bind(C, name='signal') result(old)
+      import :: c_int, c_funptr
+      integer(c_int), value :: sig
+      type(c_funptr), value :: handler
+      type(c_funptr) :: old
+    end function c_signal
+  end interface
+
+  ! Linux constants (the same on every architecture gfortran targets there except MIPS/SPARC,
+  ! which empm does not support).
+  integer(c_int), parameter :: AT_FDCWD = -100, STATX_TYPE = 1, SIGXFSZ = 25
+  integer, parameter :: S_IFMT = int(o'170000'), S_IFREG = int(o'100000'), &
+                        S_IFDIR = int(o'040000')
+
+contains
+
+  !> The id of this process.
+  integer function empm_getpid() result(pid)
+    pid = int(c_getpid())
+  end function empm_getpid
+
+  !> Whether process `pid` exists (on this machine).
+  logical function empm_process_alive(pid) result(alive)
+    integer, intent(in) :: pid !! process id
+    alive = .false.
+    if (pid <= 0) return
+    ! Signal 0 checks existence only; it fails for another user's process too (EPERM), which
+    ! /proc still shows.
+    alive = c_kill(int(pid, c_int), 0_c_int) == 0
+    if (.not. alive) inquire(file='/proc/'//itoa(pid)//'/.', exist=alive)
+  end function empm_process_alive
+
+  !> What is at `path`: PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY or PATH_OTHER. Symbolic
+  !> links are followed (a link to a regular file is a regular file).
+  integer function empm_path_kind(path) result(kind)
+    character(len=*), intent(in) :: path !! file or folder
+    integer(c_int16_t) :: buf(128)  ! struct statx: 256 bytes, the same layout on every Linux
+    integer :: mode
+    buf = 0
+    kind = PATH_MISSING
+    if (c_statx(AT_FDCWD, path//c_null_char, 0_c_int, STATX_TYPE, buf) /= 0) return
+    ! stx_mode: the 16-bit field at byte offset 28 (element 15 of 2-byte units).
+    mode = iand(int(buf(15)), 65535)
+    select case (iand(mode, S_IFMT))
+    case (S_IFREG); kind = PATH_REGULAR
+    case (S_IFDIR); kind = PATH_DIRECTORY
+    case default;   kind = PATH_OTHER
+    end select
+  end function empm_path_kind
+
+  !> The current value of `errno` (the reason of the last failed system call).
+  integer function empm_errno() result(e)
+    integer(c_int), pointer :: p
+    call c_f_pointer(c_errno_location(), p)
+    e = int(p)
+  end function empm_errno
+
+  !> The system's text for error number `e` (e.g. 'No space left on device').
+  function empm_errno_text(e) result(text)
+    integer, intent(in) :: e              !! error number (errno)
+    character(len=:), allocatable :: text !! its description
+    type(c_ptr) :: p
+    character(kind=c_char), pointer :: s(:)
+    integer :: n, k
+    text = 'error '//itoa(e)
+    p = c_strerror(int(e, c_int))
+    if (.not. c_associated(p)) return
+    call c_f_pointer(p, s, [512])
+    n = 0
+    do while (n < 512)
+      if (s(n + 1) == c_null_char) exit
+      n = n + 1
+    end do
+    if (n == 0) return
+    deallocate(text)
+    allocate(character(len=n) :: text)
+    do k = 1, n
+      text(k:k) = s(k)
+    end do
+  end function empm_errno_text
+
+  !> Ignore SIGXFSZ, so that a write beyond the file-size limit (`ulimit -f`) fails with EFBIG
+  !> and is reported as an I/O error instead of killing the process (the Fortran run-time
+  !> library's handler would print a backtrace).
+  subroutine empm_ignore_sigxfsz()
+    type(c_funptr) :: old
+    type(c_funptr) :: ign
+    ign = transfer(1_c_intptr_t, ign)  ! SIG_IGN
+    old = c_signal(SIGXFSZ, ign)
+  end subroutine empm_ignore_sigxfsz
+
+  pure function itoa(i) result(s)
+    integer, intent(in) :: i
+    character(len=:), allocatable :: s
+    character(len=24) :: b
+    write(b, '(i0)') i
+    s = trim(b)
+  end function itoa
+end module empm_posix

@@ -1,0 +1,173 @@
+#!/usr/bin/python3
+"""Output-path robustness of `empm run` (one scenario per call; CTest runs each):
+
+  concurrent  two runs writing the same -o: the second is refused at its start (status 4,
+              naming the other process); the first completes (status 0, a complete file
+              with non-zero data); no partial or lock file is left.
+  stale_lock  a lock left by a killed run (a dead process id) is taken over (status 0).
+  fifo        an existing non-regular file (a FIFO) as -o: refused (status 2, naming it),
+              left as it was.
+  directory   a folder as -o: refused (status 2), no partial or XDMF file left.
+  disk_full   the file-size limit (RLIMIT_FSIZE) below the output size: status 4, one
+              message with the system's reason, no HDF5 error stack, no crash, no file left.
+
+usage: output_target.py EMPM CASE_DIR WORK_DIR SCENARIO
+Exit 0 pass, 1 fail, 77 skipped (CTest SKIP_RETURN_CODE).
+"""
+import glob
+import os
+import resource
+import shutil
+import stat
+import subprocess
+import sys
+import time
+
+import h5py
+import numpy as np
+
+
+def fail(msg):
+    print("FAIL: " + msg)
+    sys.exit(1)
+
+
+def leftovers(work):
+    return sorted(glob.glob(os.path.join(work, "*.partial")) +
+                  glob.glob(os.path.join(work, "*.lock")))
+
+
+def run(empm, args, work, **kw):
+    p = subprocess.run([empm, "run"] + args, cwd=work, capture_output=True, text=True,
+                       errors="replace", timeout=120, **kw)
+    print(f"$ empm run {' '.join(args)}\n-> status {p.returncode}\n{p.stdout}{p.stderr}")
+    return p
+
+
+def check_complete(path):
+    with h5py.File(path, "r") as f:
+        if int(f.attrs["complete"]) != 1:
+            fail(f"{path}: complete = {f.attrs['complete']}")
+        x = f["final/x"][()]
+        if not np.all(np.isfinite(x)) or not np.any(x != 0.0):
+            fail(f"{path}: /final/x is not finite and non-zero")
+        t = f["history/time"][()]
+        if t[-1] <= 0.0:
+            fail(f"{path}: history ends at t = {t[-1]}")
+
+
+def concurrent(empm, cases, work):
+    case = os.path.join(cases, "long.nml")  # about 1 s in a Debug build
+    out = "same.h5"
+    a = subprocess.Popen([empm, "run", case, "-o", out], cwd=work, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    lock = os.path.join(work, out + ".lock")
+    t0 = time.time()
+    while not os.path.exists(lock) and a.poll() is None and time.time() - t0 < 30:
+        time.sleep(0.005)
+    if a.poll() is not None:
+        fail("the first run ended before the second could start (case too short)")
+    b = run(empm, [case, "-o", out], work)
+    a_out, a_err = a.communicate(timeout=120)
+    print(f"first run -> status {a.returncode}\n{a_out}{a_err}")
+    if b.returncode != 4:
+        fail(f"second run: status {b.returncode}, expected 4")
+    if f"process {a.pid}" not in b.stderr or "is writing this file" not in b.stderr:
+        fail("second run: the message does not name the first run's process")
+    if a.returncode != 0:
+        fail(f"first run: status {a.returncode}, expected 0")
+    check_complete(os.path.join(work, out))
+    if leftovers(work):
+        fail(f"left behind: {leftovers(work)}")
+
+
+def stale_lock(empm, cases, work):
+    dead = subprocess.Popen(["true"])
+    dead.wait()  # its id is no longer a process (reuse within the test is improbable)
+    with open(os.path.join(work, "stale.h5.lock"), "w") as f:
+        f.write(f"{dead.pid}\n")
+    p = run(empm, [os.path.join(cases, "good.nml"), "-o", "stale.h5"], work)
+    if p.returncode != 0:
+        fail(f"status {p.returncode}, expected 0 (stale lock taken over)")
+    check_complete(os.path.join(work, "stale.h5"))
+    if leftovers(work):
+        fail(f"left behind: {leftovers(work)}")
+    # A lock held by a live process (this script) is respected.
+    with open(os.path.join(work, "held.h5.lock"), "w") as f:
+        f.write(f"{os.getpid()}\n")
+    p = run(empm, [os.path.join(cases, "good.nml"), "-o", "held.h5"], work)
+    os.remove(os.path.join(work, "held.h5.lock"))
+    if p.returncode != 4 or f"process {os.getpid()}" not in p.stderr:
+        fail(f"status {p.returncode}, expected 4 naming process {os.getpid()}")
+    if os.path.exists(os.path.join(work, "held.h5")):
+        fail("held.h5 was written although another process held the lock")
+
+
+def fifo(empm, cases, work):
+    path = os.path.join(work, "pipe.h5")
+    os.mkfifo(path)
+    p = run(empm, [os.path.join(cases, "good.nml"), "-o", "pipe.h5"], work)
+    if p.returncode != 2:
+        fail(f"status {p.returncode}, expected 2")
+    if "pipe.h5: the output exists and is not a regular file" not in p.stderr:
+        fail("the message does not name the output and say why")
+    if not stat.S_ISFIFO(os.stat(path).st_mode):
+        fail("the FIFO was replaced")
+    if leftovers(work) or os.path.exists(os.path.join(work, "pipe.xmf")):
+        fail(f"left behind: {leftovers(work)}")
+
+
+def directory(empm, cases, work):
+    os.mkdir(os.path.join(work, "out.h5"))
+    p = run(empm, [os.path.join(cases, "good.nml"), "-o", "out.h5"], work)
+    if p.returncode != 2:
+        fail(f"status {p.returncode}, expected 2")
+    if "out.h5: the output exists and is a folder" not in p.stderr:
+        fail("the message does not name the output and say why")
+    if leftovers(work) or os.path.exists(os.path.join(work, "out.xmf")) or \
+            os.listdir(os.path.join(work, "out.h5")):
+        fail(f"left behind: {leftovers(work)}")
+
+
+def disk_full(empm, cases, work):
+    limit = 16 * 1024  # good.nml writes about 40 kB
+
+    def limit_size():
+        resource.setrlimit(resource.RLIMIT_FSIZE, (limit, limit))
+
+    try:
+        soft, hard = resource.getrlimit(resource.RLIMIT_FSIZE)
+        if hard != resource.RLIM_INFINITY and hard < limit:
+            print("SKIP: the file-size limit cannot be set here")
+            sys.exit(77)
+    except (ValueError, OSError) as e:
+        print(f"SKIP: {e}")
+        sys.exit(77)
+    p = run(empm, [os.path.join(cases, "good.nml"), "-o", "full.h5"], work,
+            preexec_fn=limit_size)
+    msg = p.stdout + p.stderr
+    if p.returncode != 4:
+        fail(f"status {p.returncode}, expected 4")
+    if "full.h5: writing the HDF5 output" not in msg or "File too large" not in msg:
+        fail("no single message with the system's reason")
+    if "HDF5-DIAG" in msg or "Backtrace" in msg:
+        fail("HDF5's error stack or a backtrace was printed")
+    if msg.count("error:") != 1:
+        fail("expected exactly one error line")
+    if os.path.exists(os.path.join(work, "full.h5")) or leftovers(work) or \
+            os.path.exists(os.path.join(work, "full.xmf")):
+        fail(f"left behind: {os.listdir(work)}")
+
+
+def main():
+    empm, cases, work, scenario = sys.argv[1:5]
+    work = os.path.join(work, scenario)
+    shutil.rmtree(work, ignore_errors=True)
+    os.makedirs(work)
+    {"concurrent": concurrent, "stale_lock": stale_lock, "fifo": fifo,
+     "directory": directory, "disk_full": disk_full}[scenario](empm, cases, work)
+    print("PASS")
+
+
+if __name__ == "__main__":
+    main()
