@@ -334,7 +334,7 @@ contains
     real(wp), intent(out) :: devol                 !! increment of eps_p_vol
     integer, intent(out) :: region                 !! MC_* region
     integer, intent(out) :: info                   !! 0 ok, 1 failed
-    real(wp) :: scale, lam(3), s, cs, k, st, ds, dk, dst
+    real(wp) :: scale, lam(3), s, cs, k, st, ds, dk, dst, ep(3)
     integer :: ic, i, j, l, nap, ap(9), set(3)
     logical :: ok, conv
     sig = str; dkappa = 0.0_wp; devol = 0.0_wp; info = 0
@@ -344,6 +344,18 @@ contains
     scale = max(maxval(abs(str)) + self%c0, 1.0e-200_wp)
     do ic = 1, NCAND
       if (.not. self%cutoff .and. any(CAND(1:CAND_N(ic), ic) >= 4)) cycle
+      ! With the cut-off at the apex (and fixed strength) every set after the two edges
+      ! returns to the apex point: the cut-off planes meet the MC cone only there. Its
+      ! region is then what the main plane and the edges leave (the regions tile the space),
+      ! so the apex is taken at once; the plastic strain is D⁻¹(σ* − σ).
+      if (ic == 4 .and. self%cutoff_apex .and. self%eps_soft <= 0.0_wp) then
+        sig = st
+        ep = (str - sig) / (2.0_wp * self%G)
+        ep = ep - self%lam / (2.0_wp * self%G) * sum(str - sig) / (3.0_wp * self%K)
+        devol = sum(ep)
+        dkappa = sqrt(2.0_wp / 3.0_wp * sum((ep - devol / 3.0_wp)**2))
+        region = MC_APEX; return
+      end if
       call try_set(CAND(:, ic), CAND_N(ic), lam, sig, dkappa, devol, ok, conv)
       if (.not. conv) then
         region = MC_NO_CONVERGENCE; info = 1; sig = str; return
