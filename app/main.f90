@@ -112,6 +112,8 @@ program empm_main
       case ('--warmup');     bcfg%warmup = int_arg(i)
       case ('--threads');    bcfg%threads = int_arg(i)
       case ('--integrator'); bcfg%integrator = arg(i + 1)
+      case ('--material');   bcfg%material = arg(i + 1)
+      case ('--material-keys'); bcfg%material_keys = arg(i + 1)
       case default;          call die('unknown option '//arg(i))
       end select
       i = i + 2
@@ -202,12 +204,18 @@ contains
     integer, intent(in) :: u
     write(u, '(a)') 'usage: empm bench [--dim 2|3] [--shape S] [--cells N] [--ppc P] [--steps K]'
     write(u, '(a)') '                  [--threads T] [--integrator I] [--warmup W]'
+    write(u, '(a)') '                  [--material M] [--material-keys ''k = v, ...'']'
     write(u, '(a)') ''
-    write(u, '(a)') 'Times a freely vibrating elastic block (N^dim cells, P particles per cell) and'
+    write(u, '(a)') 'Times a freely vibrating block (N^dim cells, P particles per cell) and'
     write(u, '(a)') 'prints one JSON object (docs/performance.md). S is a shape identifier as in a'
     write(u, '(a)') 'case file: linear, ugimp, bspline2, bspline3, lme, lme_g<gamma>; I an'
     write(u, '(a)') 'integrator (usf, usl, musl, pc_published, pc_newmark, gen_alpha); K timed'
-    write(u, '(a)') 'steps after W warm-up steps on T threads.'
+    write(u, '(a)') 'steps after W warm-up steps on T threads. M is a material model (empm keys;'
+    write(u, '(a)') 'default linear_elastic) with E = 1e7 Pa, nu = 0.3, density = 1000 kg/m3 and'
+    write(u, '(a)') 'bench defaults that make soil models yield (mohr_coulomb: cohesion = 500,'
+    write(u, '(a)') 'friction_angle = 30, dilatancy_angle = 5); --material-keys replaces keys of'
+    write(u, '(a)') 'the same name and adds others. "plastic_fraction" in the output is the share'
+    write(u, '(a)') 'of particle updates that changed a state variable.'
   end subroutine usage_bench
 
   subroutine usage_keys(u)
@@ -225,6 +233,7 @@ contains
     write(u, '(a)') '       empm keys'
     write(u, '(a)') '       empm bench [--dim 2|3] [--shape S] [--cells N] [--ppc P] [--steps K]'
     write(u, '(a)') '                  [--threads T] [--integrator I] [--warmup W]'
+    write(u, '(a)') '                  [--material M] [--material-keys ''k = v, ...'']'
     write(u, '(a)') '       empm --help | --version'
     write(u, '(a)') '       empm COMMAND --help'
     write(u, '(a)') ''

@@ -10,6 +10,14 @@
 !> family. The initial velocity is a smooth standing-wave field of
 !> small amplitude (the block is linear elastic and nothing is fixed); Δt is half the CFL limit.
 !> The timed loop calls the integrator's `step` only: no guards, no last-good copy, no output.
+!>
+!> The material is any registered model (`--material`, default linear_elastic) with the bench's
+!> elastic constants (the keys `E`, `nu`, `density` a model declares), the model's bench
+!> defaults (soil models: a strength that the block's vibration exceeds, so that the bench
+!> times plastic updates; [[bench_material_keys]]) and the user's `--material-keys`, which
+!> replace defaults of the same name. For a model with state variables the fraction of
+!> particle updates that changed a state variable (a plastic update, for the plasticity
+!> models) is reported; it is counted between the timed steps, outside the timing.
 module empm_bench
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp, pi
@@ -17,12 +25,14 @@ module empm_bench
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_particle_gen, only: empm_fill, GEOM_BOX, PLACE_GAUSS
   use empm_namelist, only: empm_kv
-  use empm_registry, only: empm_create_shape, empm_create_material, empm_create_integrator
+  use empm_registry, only: empm_create_shape, empm_create_material, empm_create_integrator, &
+                           empm_registry_t, empm_default_registry
+  use empm_params, only: empm_param_t
   use empm_integrator, only: empm_integrator_t
   use empm_solver, only: empm_stable_dt
   use empm_timer, only: PHASE_COUNT, PHASE_NAMES
   use empm_parallel, only: empm_set_threads, empm_max_threads
-  use empm_strings, only: str
+  use empm_strings, only: str, lower
   use empm_files, only: empm_proc_kib
   implicit none
   private
@@ -44,6 +54,8 @@ module empm_bench
     integer :: warmup = 3                           !! untimed steps first
     integer :: threads = 1                          !! OpenMP threads
     character(len=32) :: integrator = 'pc_newmark'  !! scheme name, as in a case file
+    character(len=32) :: material = 'linear_elastic' !! material model, a registry name
+    character(len=512) :: material_keys = ''         !! 'key = value, ...' replacing defaults
   end type empm_bench_config_t
 
   !> What was measured (the JSON of `empm bench`, plus a checksum for tests).
@@ -51,6 +63,10 @@ module empm_bench
     integer :: dim = 0                                  !! spatial dimension
     character(len=:), allocatable :: shape              !! family identifier, e.g. lme_g3
     character(len=:), allocatable :: integrator         !! scheme identifier
+    character(len=:), allocatable :: material           !! material model
+    character(len=:), allocatable :: material_keys      !! the keys it was created with
+    real(wp) :: plastic_fraction = 0.0_wp               !! particle updates that changed a
+                                                        !! state variable / all (timed steps)
     integer :: particles = 0                            !! particles
     integer :: nodes = 0                                !! grid nodes
     integer :: steps = 0                                !! timed steps
@@ -77,7 +93,9 @@ contains
     type(empm_error_t) :: e
     real(wp) :: zero3(3), hi(3), origin(3), h(3), dt, s
     integer :: nper, pad, nd, info, nadd, p, d, k, ncell(3)
-    integer(int64) :: rss0, rss1, c0, c1, rate
+    integer(int64) :: rss0, rss1, c0, c1, rate, ticks, nchanged
+    real(wp), allocatable :: state0(:,:)
+    character(len=:), allocatable :: mkeys
 
     nd = cfg%dim
     if (nd < 2 .or. nd > 3) then
@@ -115,8 +133,12 @@ contains
       call empm_raise(EMPM_ERR_USAGE, 'bench: --integrator: '//e%message, err); return
     end if
     allocate(model%mats(1))
-    call empm_create_material('linear_elastic', empm_kv('E', BENCH_E)//empm_kv('nu', BENCH_NU)// &
-                              empm_kv('density', BENCH_RHO), model%mats(1)%model, e)
+    call bench_material_keys(trim(cfg%material), trim(cfg%material_keys), mkeys, e)
+    if (e%code == 0) call empm_create_material(trim(cfg%material), mkeys, model%mats(1)%model, e)
+    if (e%code /= 0) then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: --material '//trim(cfg%material)//': '// &
+                      e%message, err); return
+    end if
     ! Exact capacity: no geometric growth (it would double the footprint being measured).
     call model%pts%alloc(nd, cfg%ppc * cfg%cells**nd)
     zero3 = 0.0_wp; hi = 0.0_wp; hi(1:nd) = 1.0_wp
@@ -144,12 +166,19 @@ contains
       if (stat%code /= STEP_OK) return
     end do
     call integ%timer%reset()
-    call system_clock(c0, rate)
+    ! Each step timed alone, so that the state comparison stays outside the timing.
+    ticks = 0; nchanged = 0
+    if (model%pts%nstate > 0) allocate(state0(model%pts%nstate, model%pts%np))
     do k = 1, cfg%steps
+      if (allocated(state0)) state0 = model%pts%state(:, 1:model%pts%np)
+      call system_clock(c0, rate)
       call advance()
+      call system_clock(c1)
+      ticks = ticks + (c1 - c0)
       if (stat%code /= STEP_OK) return
+      if (allocated(state0)) nchanged = nchanged + &
+        count(any(state0 /= model%pts%state(:, 1:model%pts%np), dim=1))
     end do
-    call system_clock(c1)
     rss1 = empm_peak_rss_bytes()
 
     res%dim = nd
@@ -159,7 +188,10 @@ contains
     res%nodes = model%grid%nnode
     res%steps = cfg%steps
     res%threads = empm_max_threads()
-    res%seconds = real(c1 - c0, wp) / real(rate, wp)
+    res%material = trim(cfg%material)
+    res%material_keys = mkeys
+    res%plastic_fraction = real(nchanged, wp) / (real(model%pts%np, wp) * cfg%steps)
+    res%seconds = real(ticks, wp) / real(rate, wp)
     res%particle_steps_per_second = real(res%particles, wp) * cfg%steps / max(res%seconds, 1.0e-9_wp)
     if (integ%timer%basis_evals > 0) res%newton_iterations_mean = &
       real(integ%timer%newton_iters, wp) / real(integ%timer%basis_evals, wp)
@@ -184,6 +216,81 @@ contains
     end subroutine advance
   end subroutine empm_bench_run
 
+  !> The keys of the bench material: the bench's `E`, `nu`, `density` where the model declares
+  !> them, the model's bench defaults, then `user` ('key = value, ...'), whose keys replace
+  !> defaults of the same name. Bench defaults: mohr_coulomb c = 500 Pa, φ = 30°, ψ = 5°
+  !> (the block's stresses reach ~1e4 Pa from zero, so most of it yields; the cut-off is the
+  !> apex value c cot φ ≈ 870 Pa, and the block has no confinement: shear, cut-off and apex
+  !> returns all occur).
+  subroutine bench_material_keys(name, user, keys, err)
+    character(len=*), intent(in) :: name                !! registry name
+    character(len=*), intent(in) :: user                !! user keys ('' for none)
+    character(len=:), allocatable, intent(out) :: keys  !! the keys to create it with
+    type(empm_error_t), intent(inout) :: err            !! set for an unknown model
+    type(empm_registry_t) :: reg
+    type(empm_param_t), allocatable :: p(:)
+    character(len=:), allocatable :: dflt
+    integer :: k, im
+    reg = empm_default_registry()
+    im = 0
+    do k = 1, size(reg%materials)
+      if (reg%materials(k)%proto%family() == name) im = k
+    end do
+    keys = user
+    if (im == 0) return  ! creating it reports the unknown model with the valid names
+    allocate(p, source=reg%materials(im)%proto%params())
+    dflt = ''
+    do k = 1, size(p)
+      select case (p(k)%name)
+      case ('E');       call add(empm_kv('E', BENCH_E))
+      case ('nu');      call add(empm_kv('nu', BENCH_NU))
+      case ('density'); call add(empm_kv('density', BENCH_RHO))
+      end select
+    end do
+    select case (name)
+    case ('mohr_coulomb')
+      call add('cohesion = 500'); call add('friction_angle = 30'); call add('dilatancy_angle = 5')
+    end select
+    associate (unused_ => err); end associate
+  contains
+    ! Add 'key = value' unless the user's keys name the key.
+    subroutine add(kv)
+      character(len=*), intent(in) :: kv
+      character(len=:), allocatable :: key, item
+      item = trim(kv)
+      if (item(len(item):) == ',') item = item(1:len(item) - 1)  ! empm_kv's separator
+      key = trim(adjustl(item(1:index(item, '=') - 1)))
+      if (has_key(user, key)) return
+      if (len_trim(keys) > 0) then
+        keys = item//', '//keys
+      else
+        keys = item
+      end if
+    end subroutine add
+  end subroutine bench_material_keys
+
+  ! Whether 'k1 = v1, k2 = v2, ...' names `key` (case-insensitive).
+  pure logical function has_key(list, key)
+    character(len=*), intent(in) :: list, key
+    integer :: i, j, eq
+    character(len=:), allocatable :: item
+    has_key = .false.
+    i = 1
+    do while (i <= len(list))
+      j = index(list(i:), ',')
+      if (j == 0) then
+        item = list(i:)
+        i = len(list) + 1
+      else
+        item = list(i:i + j - 2)
+        i = i + j
+      end if
+      eq = index(item, '=')
+      if (eq == 0) cycle
+      if (lower(trim(adjustl(item(1:eq - 1)))) == lower(key)) has_key = .true.
+    end do
+  end function has_key
+
   !> Peak resident set size of this process (VmHWM of /proc/self/status) [bytes]; −1 when
   !> unavailable (not Linux).
   function empm_peak_rss_bytes() result(bytes)
@@ -198,7 +305,9 @@ contains
     character(len=:), allocatable :: s           !! {"dim":2,"shape":"lme_g3",...}
     integer :: k
     s = '{"dim":'//str(res%dim)//',"shape":"'//res%shape//'","integrator":"'// &
-      res%integrator//'","particles":'//str(res%particles)//',"nodes":'//str(res%nodes)// &
+      res%integrator//'","material":"'//res%material//'","material_keys":"'// &
+      res%material_keys//'","plastic_fraction":'//num(res%plastic_fraction)// &
+      ',"particles":'//str(res%particles)//',"nodes":'//str(res%nodes)// &
       ',"steps":'//str(res%steps)//',"threads":'//str(res%threads)//',"seconds":'// &
       num(res%seconds)//',"particle_steps_per_second":'//num(res%particle_steps_per_second)// &
       ',"newton_iterations_mean":'//num(res%newton_iterations_mean)//',"bytes_per_particle":'// &

@@ -102,13 +102,25 @@ contains
     real(wp), intent(in) :: s(6)      !! symmetric tensor, Voigt
     real(wp), intent(out) :: sig(3)   !! principal values, decreasing
     real(wp), intent(out) :: Q(3,3)   !! principal directions, column i for sig(i)
-    real(wp) :: A(3,3), c, r, th, ct, st, v(3)
+    real(wp) :: A(3,3), c, r, d, ct, st, v(3)
     integer :: i, j
     if (s(4) == 0.0_wp .and. s(5) == 0.0_wp) then
+      ! In-plane pair: c ± r with r = |(d, xy)|, d = (xx − yy)/2; the major direction at the
+      ! angle θ with cos 2θ = d/r, sin 2θ = xy/r, from the half-angle formulas (no trigonometric
+      ! calls: this runs for every particle of a 2D plasticity model). The branch on the sign
+      ! of d keeps the square root away from cancellation.
       c = 0.5_wp * (s(1) + s(2))
-      r = hypot(0.5_wp * (s(1) - s(2)), s(6))
-      th = 0.5_wp * atan2(2.0_wp * s(6), s(1) - s(2))
-      ct = cos(th); st = sin(th)
+      d = 0.5_wp * (s(1) - s(2))
+      r = hypot(d, s(6))
+      if (r == 0.0_wp) then
+        ct = 1.0_wp; st = 0.0_wp
+      else if (d >= 0.0_wp) then
+        ct = sqrt(0.5_wp * (1.0_wp + d / r))
+        st = s(6) / (2.0_wp * r * ct)
+      else
+        st = sign(sqrt(0.5_wp * (1.0_wp - d / r)), s(6))
+        ct = s(6) / (2.0_wp * r * st)
+      end if
       sig = [c + r, c - r, s(3)]
       Q = 0.0_wp
       Q(1,1) = ct; Q(2,1) = st
@@ -172,11 +184,12 @@ contains
         apq = A(p,q)
         if (apq == 0.0_wp) cycle
         app = A(p,p); aqq = A(q,q)
-        theta = (aqq - app) / (2.0_wp * apq)
-        ! t = tan of the rotation angle, the smaller root; θ² would overflow for tiny apq.
-        if (abs(theta) > 1.0e150_wp) then
-          t = 0.5_wp / theta
+        ! t = tan of the rotation angle, the smaller root. For |θ| > 1e150 (θ² would overflow,
+        ! and for a denormal apq already the division) t = 1/(2θ) = apq/(aqq − app).
+        if (abs(apq) < 0.5e-150_wp * abs(aqq - app)) then
+          t = apq / (aqq - app)
         else
+          theta = (aqq - app) / (2.0_wp * apq)
           t = sign(1.0_wp, theta) / (abs(theta) + sqrt(theta**2 + 1.0_wp))
         end if
         c = 1.0_wp / sqrt(t**2 + 1.0_wp)
