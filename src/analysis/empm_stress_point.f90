@@ -113,7 +113,10 @@ contains
     real(wp), intent(out), optional :: Lused(3,3) !! the gradient applied, unknowns included
     integer :: idx(6), nu, k, j, it, mi
     real(wp) :: x(6), xt(6), r(6), rt(6), jac(6,6), dx(6), h, scale, rnorm, rnew, lam, xscale
-    real(wp) :: s(6)
+    real(wp) :: s(6), jtj(6,6), mu
+    integer :: km
+    real(wp), parameter :: MUS(6) = [1.0e-12_wp, 1.0e-9_wp, 1.0e-6_wp, 1.0e-3_wp, 1.0e-1_wp, &
+                                     1.0e1_wp]
     type(empm_sp_point_t) :: trial
     nu = 0
     do k = 1, 6
@@ -148,21 +151,38 @@ contains
         end if
         jac(1:nu, j) = (rt(1:nu) - r(1:nu)) / h
       end do
-      call solve(jac(1:nu, 1:nu), -r(1:nu), dx(1:nu), mi)
-      if (mi /= 0) then
-        info = -1; exit
-      end if
-      ! Backtracking on the residual's max norm (corners of the yield surface).
-      lam = 1.0_wp
-      do k = 1, 30
-        xt(1:nu) = x(1:nu) + lam * dx(1:nu)
-        call residual(xt(1:nu), rt(1:nu), s, mi)
-        if (mi /= 0) then
-          info = mi; return
+      ! The Newton step, then, if it does not reduce the residual, Levenberg–Marquardt steps
+      ! (JᵀJ + μ I) dx = −Jᵀr of increasing μ: at a corner of a perfectly plastic surface the
+      ! strain rates that hold the stresses are not unique (e.g. the split of the lateral
+      ! flow between two active planes), J is singular and the Newton step wanders along
+      ! its null space; the damped step is the shortest one.
+      rnew = rnorm
+      do km = 0, size(MUS)
+        if (km == 0) then
+          call solve(jac(1:nu, 1:nu), -r(1:nu), dx(1:nu), mi)
+        else
+          jtj(1:nu, 1:nu) = matmul(transpose(jac(1:nu, 1:nu)), jac(1:nu, 1:nu))
+          mu = MUS(km) * max(maxval([(jtj(k, k), k = 1, nu)]), tiny(1.0_wp))
+          do k = 1, nu
+            jtj(k, k) = jtj(k, k) + mu
+          end do
+          call solve(jtj(1:nu, 1:nu), -matmul(transpose(jac(1:nu, 1:nu)), r(1:nu)), &
+                     dx(1:nu), mi)
         end if
-        rnew = maxval(abs(rt(1:nu)))
+        if (mi /= 0) cycle
+        ! Backtracking on the residual's max norm.
+        lam = 1.0_wp
+        do k = 1, 30
+          xt(1:nu) = x(1:nu) + lam * dx(1:nu)
+          call residual(xt(1:nu), rt(1:nu), s, mi)
+          if (mi /= 0) then
+            info = mi; return
+          end if
+          rnew = maxval(abs(rt(1:nu)))
+          if (rnew < rnorm) exit
+          lam = 0.5_wp * lam
+        end do
         if (rnew < rnorm) exit
-        lam = 0.5_wp * lam
       end do
       if (.not. rnew < rnorm) exit ! stagnated: at the round-off floor
       x(1:nu) = xt(1:nu); r(1:nu) = rt(1:nu); rnorm = rnew
