@@ -355,7 +355,7 @@ contains
     real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
     type(empm_material_ctx_t), intent(in) :: ctx     !! unused
     integer, intent(out) :: info                     !! 0 ok; k > 0 particle k failed; −1 shapes
-    real(wp) :: de(6), tr, sig(6), m_tr, t_tr, m, t, lam2
+    real(wp) :: de(6), tr, sig(6), m_tr, t_tr, m, t
     integer :: p, n, region
     associate (unused_ => ctx); end associate
     info = 0
@@ -365,7 +365,6 @@ contains
       info = -1
       return
     end if
-    lam2 = self%K - 2.0_wp * self%G / 3.0_wp
     do p = 1, n
       de(1) = dt * L(1,1,p)
       de(2) = dt * L(2,2,p)
@@ -380,7 +379,9 @@ contains
       end if
       strain(:,p) = strain(:,p) + de
       call jaumann_rotate(dt, L(:,:,p), stress(:,p))
-      sig(1:3) = stress(1:3,p) + lam2 * tr + 2.0_wp * self%G * de(1:3)
+      ! The elastic predictor in linear_elastic's operation order: with an unreachable
+      ! strength the two models agree bitwise.
+      sig(1:3) = stress(1:3,p) + self%lambda * tr + 2.0_wp * self%G * de(1:3)
       sig(4:6) = stress(4:6,p) + 2.0_wp * self%G * de(4:6)
       call empm_dp_return(self, sig, stress(:,p), region, m_tr, t_tr, m, t)
       if (region /= DP_ELASTIC) then
