@@ -4,13 +4,13 @@
 !> The library is loaded once, in `configure` ([[empm_dynlib]]); a missing library or symbol is
 !> an input error quoting the loader's message. Each step, for each particle, the adapter
 !>
-!> 1. rotates the stress and the total strain with the step's Cayley rotation Q ([[jaumann_rotate]],
-!>    the same rotation as the native rate-form models) and passes Q as DROT;
+!> 1. rotates the stress and the total strain with the step's Cayley rotation Q (the formula and
+!>    operations of [[jaumann_rotate]], as the native rate-form models) and passes Q as DROT;
 !> 2. converts to the Abaqus conventions: components 11, 22, 33, 12, 13, 23 (empm stores xx, yy,
 !>    zz, yz, xz, xy), engineering shear strains in STRAN and DSTRAN; 3D: NDI = 3, NSHR = 3;
 !>    2D plane strain and 1D uniaxial strain: NDI = 3, NSHR = 1 (in 1D the shears stay zero);
 !> 3. calls the UMAT with Δε = Δt sym(L), DFGRD0 = F at the start, DFGRD1 = F advanced with L
-!>    ([[advance_f]]), TIME = t (step time = total time), DTIME = Δt, KSTEP = 1, KINC = the step
+!>    (F₁ = F₀ + Δt L F₀), TIME = t (step time = total time), DTIME = Δt, KSTEP = 1, KINC = the step
 !>    number, NOEL = the particle index, NPT = LAYER = KSPT = 1, CELENT = the smallest grid
 !>    spacing, COORDS = 0 (the material interface carries no positions), TEMP = DTEMP = 0;
 !> 4. checks the result: a non-finite STRESS, a write past STATEV(NSTATV) (guard values after
@@ -37,8 +37,7 @@ module empm_material_umat
   use empm_namelist, only: empm_group_t
   use empm_material, only: empm_material_t, empm_material_ctx_t, STATE_NAME_LEN
   use empm_material_linear_elastic, only: empm_lame
-  use empm_tensor, only: advance_f
-  use empm_plasticity, only: jaumann_rotate, cayley_rotation, strain_increment
+  use empm_plasticity, only: strain_increment
   use empm_dynlib, only: empm_dynlib_open, empm_dynlib_symbol
   implicit none
   private
@@ -327,38 +326,52 @@ contains
     real(wp), intent(inout), contiguous :: F(:,:,:), strain(:,:), stress(:,:), state(:,:), rho(:)
     type(empm_material_ctx_t), intent(in) :: ctx
     integer, intent(inout) :: info
-    real(wp) :: de(6), tr, s0(6), e0(6), F0(3,3), st0(self%nstatv + NEXTRA), pnewdt
     real(wp) :: statev(self%nstatv + NGUARD), props(max(1, size(self%props)))
+    real(wp) :: de(6), tr, pnewdt, time(2), sse, spd, scd, rpl, ddsddt(6), drplde(6), drpldt
+    real(wp) :: temp, dtemp, predef(1), dpred(1), coords(3), celent, dtime, ddsdde(36)
     character(len=80) :: cmname
-    integer :: p, k, why, nst
-    nst = self%nstatv + NEXTRA
+    integer(c_int) :: ndi, nshr, ntens, nstatv, nprops, noel, npt, layer, kspt, kstep, kinc
+    integer :: p, k, why, nsv, i
+    nsv = self%nstatv
     ! Copies: the UMAT receives them by reference and a careless one may write to them.
     props = 0.0_wp
     props(1:size(self%props)) = self%props
     cmname = self%cmname
+    ndi = 3
+    nshr = merge(3, 1, ctx%ndim == 3)
+    ntens = ndi + nshr
+    nstatv = int(nsv, c_int); nprops = int(size(self%props), c_int)
+    npt = 1; layer = 1; kspt = 1; kstep = 1; kinc = int(ctx%step, c_int)
+    coords = 0.0_wp; celent = ctx%h; temp = 0.0_wp; dtemp = 0.0_wp
+    predef = 0.0_wp; dpred = 0.0_wp
     do p = 1, size(rho)
-      de = strain_increment(dt, L(:,:,p))
+      associate (Lp => L(:,:,p))
+        de(1) = dt * Lp(1,1)
+        de(2) = dt * Lp(2,2)
+        de(3) = dt * Lp(3,3)
+        de(4) = 0.5_wp * dt * (Lp(2,3) + Lp(3,2))
+        de(5) = 0.5_wp * dt * (Lp(1,3) + Lp(3,1))
+        de(6) = 0.5_wp * dt * (Lp(1,2) + Lp(2,1))
+      end associate
       tr = de(1) + de(2) + de(3)
       if (1.0_wp + tr <= 0.0_wp) then ! as the native models: an inverted particle
         call fail(p, WHY_VOLUME)
         cycle
       end if
-      s0 = stress(:,p); e0 = strain(:,p); F0 = F(:,:,p); st0 = state(1:nst,p)
+      noel = int(ctx%first + p - 1, c_int)
       k = 1
       do
         call increments(p, k, why, pnewdt)
-        if (why == 0) exit
-        stress(:,p) = s0; strain(:,p) = e0; F(:,:,p) = F0; state(1:nst,p) = st0
-        if (why /= WHY_PNEWDT) exit
-        if (k >= UMAT_MAX_SUB) exit
+        if (why /= WHY_PNEWDT .or. k >= UMAT_MAX_SUB) exit
         ! At least the ratio asked for, and at least twice as many as refused.
-        k = min(UMAT_MAX_SUB, max(2 * k, ceiling(real(k, wp) / max(pnewdt, 1.0_wp / UMAT_MAX_SUB))))
+        k = min(UMAT_MAX_SUB, max(2 * k, &
+          ceiling(real(k, wp) / max(pnewdt, 1.0_wp / UMAT_MAX_SUB))))
       end do
       if (why /= 0) then
         call fail(p, why)
         cycle
       end if
-      if (k > 1) state(nst,p) = state(nst,p) + 1.0_wp
+      if (k > 1) state(nsv + NEXTRA, p) = state(nsv + NEXTRA, p) + 1.0_wp
       rho(p) = rho(p) / (1.0_wp + tr)
     end do
 
@@ -371,51 +384,50 @@ contains
       self%why = code
     end subroutine fail
 
-    ! Particle p's step in k equal sub-increments; why = 0 on success, else WHY_* (pnewdt then
-    ! holds the UMAT's ratio when it refused).
+    ! Particle p's step in k equal sub-increments, on local copies that are stored only when
+    ! every sub-increment succeeded (so a refusal or a failure leaves the particle as it was).
+    ! why = 0 on success, else WHY_* (pnewdt then holds the UMAT's ratio when it refused).
     subroutine increments(p, k, why, pnewdt)
       integer, intent(in) :: p, k
       integer, intent(out) :: why
       real(wp), intent(out) :: pnewdt
-      real(wp) :: h, dsub(6), drot(3,3), F1(3,3), sig(6), stran(6), dstran(6), ddsdde(36)
-      real(wp) :: time(2), sse, spd, scd, rpl, ddsddt(6), drplde(6), drpldt, temp, dtemp
-      real(wp) :: predef(1), dpred(1), coords(3), celent, dtime
-      integer(c_int) :: ndi, nshr, ntens, nstatv, nprops, noel, npt, layer, kspt, kstep, kinc
-      integer :: j, i
+      real(wp) :: h, dsub(6), drot(3,3), F0(3,3), F1(3,3), sig(6), stran(6), dstran(6)
+      real(wp) :: s(6), e(6)
+      integer :: j
+      logical :: spin
       h = dt / k
-      dsub = strain_increment(h, L(:,:,p))
-      ndi = 3
-      nshr = merge(3, 1, ctx%ndim == 3)
-      ntens = ndi + nshr
-      nstatv = int(self%nstatv, c_int); nprops = int(size(self%props), c_int)
-      noel = int(ctx%first + p - 1, c_int); npt = 1; layer = 1; kspt = 1; kstep = 1
-      kinc = int(ctx%step, c_int)
-      coords = 0.0_wp; celent = ctx%h; temp = 0.0_wp; dtemp = 0.0_wp
-      predef = 0.0_wp; dpred = 0.0_wp
+      if (k == 1) then
+        dsub = de
+      else
+        dsub = strain_increment(h, L(:,:,p))
+      end if
+      s = stress(:,p); e = strain(:,p); F0 = F(:,:,p)
+      statev(1:nsv) = state(1:nsv, p)
+      sse = state(nsv + 1, p); spd = state(nsv + 2, p); scd = state(nsv + 3, p)
       why = 0; pnewdt = 1.0_wp
+      call step_rotation(h, L(:,:,p), drot, spin)
       do j = 1, k
-        call jaumann_rotate(h, L(:,:,p), stress(:,p))
-        call jaumann_rotate(h, L(:,:,p), strain(:,p))
-        drot = cayley_rotation(h, L(:,:,p))
-        F1 = advance_f(h, L(:,:,p), F(:,:,p))
-        call to_abaqus(stress(:,p), 1.0_wp, sig)
-        call to_abaqus(strain(:,p), 2.0_wp, stran)
+        if (spin) then
+          call rotate(drot, s)
+          call rotate(drot, e)
+        end if
+        call advance(h, L(:,:,p), F0, F1)
+        call to_abaqus(s, 1.0_wp, sig)
+        call to_abaqus(e, 2.0_wp, stran)
         call to_abaqus(dsub, 2.0_wp, dstran)
-        statev(1:self%nstatv) = state(1:self%nstatv, p)
-        do i = self%nstatv + 1, self%nstatv + NGUARD
+        do i = nsv + 1, nsv + NGUARD
           statev(i) = transfer(GUARD_BITS, 1.0_wp)
         end do
-        sse = state(self%nstatv + 1, p); spd = state(self%nstatv + 2, p)
-        scd = state(self%nstatv + 3, p)
-        ddsdde = 0.0_wp; ddsddt = 0.0_wp; drplde = 0.0_wp; rpl = 0.0_wp; drpldt = 0.0_wp
+        ddsdde(1:ntens * ntens) = 0.0_wp
+        ddsddt = 0.0_wp; drplde = 0.0_wp; rpl = 0.0_wp; drpldt = 0.0_wp
         time = ctx%t + (j - 1) * h
         dtime = h
         pnewdt = 1.0e36_wp ! "no limit": a UMAT lowers it to ask for a smaller increment
         call umat(sig, statev, ddsdde, sse, spd, scd, rpl, ddsddt, drplde, drpldt, stran, &
           dstran, time, dtime, temp, dtemp, predef, dpred, cmname, ndi, nshr, ntens, &
-          nstatv, props, nprops, coords, drot, pnewdt, celent, F(:,:,p), F1, noel, npt, &
+          nstatv, props, nprops, coords, drot, pnewdt, celent, F0, F1, noel, npt, &
           layer, kspt, kstep, kinc, int(len(cmname), c_size_t))
-        do i = self%nstatv + 1, self%nstatv + NGUARD
+        do i = nsv + 1, nsv + NGUARD
           if (transfer(statev(i), GUARD_BITS) /= GUARD_BITS) then
             why = WHY_NSTATV; return
           end if
@@ -428,14 +440,88 @@ contains
         if (pnewdt < 1.0_wp) then
           why = WHY_PNEWDT; return
         end if
-        call from_abaqus(sig, stress(:,p))
-        strain(:,p) = strain(:,p) + dsub
-        state(1:self%nstatv, p) = statev(1:self%nstatv)
-        state(self%nstatv + 1, p) = sse; state(self%nstatv + 2, p) = spd
-        state(self%nstatv + 3, p) = scd
-        F(:,:,p) = F1
+        call from_abaqus(sig, s)
+        e = e + dsub
+        F0 = F1
       end do
+      stress(:,p) = s; strain(:,p) = e; F(:,:,p) = F0
+      state(1:nsv, p) = statev(1:nsv)
+      state(nsv + 1, p) = sse; state(nsv + 2, p) = spd; state(nsv + 3, p) = scd
     end subroutine increments
+
+    ! The step's rotation Q = (I − ½ΔtW)⁻¹(I + ½ΔtW), W = skew(L), with the formula (and the
+    ! operations) of jaumann_rotate in empm_plasticity, which the native rate-form models use:
+    ! the UMAT's stress is rotated exactly as theirs. spin = false when W = 0 (Q = I).
+    pure subroutine step_rotation(dt, L, Q, spin)
+      real(wp), intent(in) :: dt, L(3,3)
+      real(wp), intent(out) :: Q(3,3)
+      logical, intent(out) :: spin
+      real(wp) :: a(3), c
+      integer :: i, j
+      a(1) = 0.25_wp * dt * (L(3,2) - L(2,3))
+      a(2) = 0.25_wp * dt * (L(1,3) - L(3,1))
+      a(3) = 0.25_wp * dt * (L(2,1) - L(1,2))
+      Q = 0.0_wp
+      Q(1,1) = 1.0_wp; Q(2,2) = 1.0_wp; Q(3,3) = 1.0_wp
+      spin = .not. (a(1) == 0.0_wp .and. a(2) == 0.0_wp .and. a(3) == 0.0_wp)
+      if (.not. spin) return
+      c = 2.0_wp / (1.0_wp + a(1)**2 + a(2)**2 + a(3)**2)
+      do j = 1, 3
+        do i = 1, 3
+          Q(i,j) = c * a(i) * a(j)
+        end do
+      end do
+      Q(1,1) = Q(1,1) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
+      Q(2,2) = Q(2,2) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
+      Q(3,3) = Q(3,3) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
+      Q(1,2) = Q(1,2) - c * a(3); Q(2,1) = Q(2,1) + c * a(3)
+      Q(1,3) = Q(1,3) + c * a(2); Q(3,1) = Q(3,1) - c * a(2)
+      Q(2,3) = Q(2,3) - c * a(1); Q(3,2) = Q(3,2) + c * a(1)
+    end subroutine step_rotation
+
+    ! t ← Q t Qᵀ for a symmetric tensor in Voigt form (tensor shears), as jaumann_rotate does
+    ! (Q (t Qᵀ), then the symmetric part). In plane strain (ntens = 4) Q and t have no 13, 23
+    ! entries: the terms dropped are exact zeros, so the sums are the same.
+    pure subroutine rotate(Q, t)
+      real(wp), intent(in) :: Q(3,3)
+      real(wp), intent(inout) :: t(6)
+      real(wp) :: T3(3,3), R(3,3), M(3,3)
+      if (ntens == 4) then
+        M(1,1) = t(1) * Q(1,1) + t(6) * Q(1,2)
+        M(1,2) = t(1) * Q(2,1) + t(6) * Q(2,2)
+        M(2,1) = t(6) * Q(1,1) + t(2) * Q(1,2)
+        M(2,2) = t(6) * Q(2,1) + t(2) * Q(2,2)
+        R(1,1) = Q(1,1) * M(1,1) + Q(1,2) * M(2,1)
+        R(2,2) = Q(2,1) * M(1,2) + Q(2,2) * M(2,2)
+        R(1,2) = Q(1,1) * M(1,2) + Q(1,2) * M(2,2)
+        R(2,1) = Q(2,1) * M(1,1) + Q(2,2) * M(2,1)
+        t(1) = R(1,1); t(2) = R(2,2)
+        t(3) = Q(3,3) * (t(3) * Q(3,3))
+        t(6) = 0.5_wp * (R(1,2) + R(2,1))
+        return
+      end if
+      T3(1,1) = t(1); T3(2,2) = t(2); T3(3,3) = t(3)
+      T3(2,3) = t(4); T3(3,2) = t(4)
+      T3(1,3) = t(5); T3(3,1) = t(5)
+      T3(1,2) = t(6); T3(2,1) = t(6)
+      R = matmul(Q, matmul(T3, transpose(Q)))
+      t(1) = R(1,1); t(2) = R(2,2); t(3) = R(3,3)
+      t(4) = 0.5_wp * (R(2,3) + R(3,2))
+      t(5) = 0.5_wp * (R(1,3) + R(3,1))
+      t(6) = 0.5_wp * (R(1,2) + R(2,1))
+    end subroutine rotate
+
+    ! F₁ = F₀ + Δt L F₀ (as advance_f in empm_tensor, here to be inlined).
+    pure subroutine advance(dt, L, F0, F1)
+      real(wp), intent(in) :: dt, L(3,3), F0(3,3)
+      real(wp), intent(out) :: F1(3,3)
+      integer :: i, j
+      do j = 1, 3
+        do i = 1, 3
+          F1(i,j) = F0(i,j) + dt * (L(i,1) * F0(1,j) + L(i,2) * F0(2,j) + L(i,3) * F0(3,j))
+        end do
+      end do
+    end subroutine advance
 
     ! empm Voigt (xx, yy, zz, yz, xz, xy) → Abaqus (11, 22, 33, 12, 13, 23) with the shears
     ! scaled by `g` (2 for engineering strains); NTENS = 4 keeps 12 only.
@@ -446,7 +532,7 @@ contains
       a(4) = g * v(6)
       a(5) = g * v(5)
       a(6) = g * v(4)
-      if (ctx%ndim /= 3) a(5:6) = 0.0_wp
+      if (ntens == 4) a(5:6) = 0.0_wp
     end subroutine to_abaqus
 
     pure subroutine from_abaqus(a, v)
@@ -454,7 +540,7 @@ contains
       real(wp), intent(inout) :: v(6)
       v(1:3) = a(1:3)
       v(6) = a(4)
-      if (ctx%ndim == 3) then
+      if (ntens == 6) then
         v(5) = a(5); v(4) = a(6)
       end if
     end subroutine from_abaqus

@@ -11,7 +11,6 @@ module empm_plasticity
   private
   public :: strain_increment, jaumann_rotate, elastic_increment, mean_deviator
   public :: principal_decompose, principal_compose
-  public :: cayley_rotation
 
 contains
 
@@ -200,33 +199,4 @@ contains
       end do
     end do
   end subroutine jacobi3
-
-  !> The rotation of a step used by [[jaumann_rotate]], as a matrix: Q = (I − ½ΔtW)⁻¹(I + ½ΔtW),
-  !> W = skew(L), computed with the same formula (the identity when W = 0). For adapters that
-  !> hand the rotation to user code (the Abaqus UMAT's DROT).
-  pure function cayley_rotation(dt, L) result(Q)
-    real(wp), intent(in) :: dt       !! time step [s]
-    real(wp), intent(in) :: L(3,3)   !! velocity gradient [1/s]
-    real(wp) :: Q(3,3)               !! orthogonal rotation of the step
-    real(wp) :: a(3), c
-    integer :: i, j
-    a(1) = 0.25_wp * dt * (L(3,2) - L(2,3))
-    a(2) = 0.25_wp * dt * (L(1,3) - L(3,1))
-    a(3) = 0.25_wp * dt * (L(2,1) - L(1,2))
-    Q = 0.0_wp
-    Q(1,1) = 1.0_wp; Q(2,2) = 1.0_wp; Q(3,3) = 1.0_wp
-    if (a(1) == 0.0_wp .and. a(2) == 0.0_wp .and. a(3) == 0.0_wp) return
-    c = 2.0_wp / (1.0_wp + a(1)**2 + a(2)**2 + a(3)**2)
-    do j = 1, 3
-      do i = 1, 3
-        Q(i,j) = c * a(i) * a(j)
-      end do
-    end do
-    Q(1,1) = Q(1,1) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
-    Q(2,2) = Q(2,2) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
-    Q(3,3) = Q(3,3) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
-    Q(1,2) = Q(1,2) - c * a(3); Q(2,1) = Q(2,1) + c * a(3)
-    Q(1,3) = Q(1,3) + c * a(2); Q(3,1) = Q(3,1) - c * a(2)
-    Q(2,3) = Q(2,3) - c * a(1); Q(3,2) = Q(3,2) + c * a(1)
-  end function cayley_rotation
 end module empm_plasticity
