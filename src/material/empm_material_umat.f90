@@ -326,7 +326,9 @@ contains
     real(wp), intent(inout), contiguous :: F(:,:,:), strain(:,:), stress(:,:), state(:,:), rho(:)
     type(empm_material_ctx_t), intent(in) :: ctx
     integer, intent(inout) :: info
-    real(wp) :: statev(self%nstatv + NGUARD), props(max(1, size(self%props)))
+    ! Fixed sizes: no allocation in the time loop, and an overrun of STATEV past the guards
+    ! still lands in this array (up to MAX_STATEV + NGUARD values).
+    real(wp) :: statev(MAX_STATEV + NGUARD), props(UMAT_MAX_PROPS)
     real(wp) :: de(6), tr, pnewdt, time(2), sse, spd, scd, rpl, ddsddt(6), drplde(6), drpldt
     real(wp) :: temp, dtemp, predef(1), dpred(1), coords(3), celent, dtime, ddsdde(36)
     character(len=80) :: cmname
@@ -344,6 +346,12 @@ contains
     npt = 1; layer = 1; kspt = 1; kstep = 1; kinc = int(ctx%step, c_int)
     coords = 0.0_wp; celent = ctx%h; temp = 0.0_wp; dtemp = 0.0_wp
     predef = 0.0_wp; dpred = 0.0_wp
+    ! Outputs the adapter does not use, and the guards after STATEV(NSTATV): set once per
+    ! batch (the guards are checked after every call, and a changed one ends the batch's use).
+    ddsdde = 0.0_wp; ddsddt = 0.0_wp; drplde = 0.0_wp; rpl = 0.0_wp; drpldt = 0.0_wp
+    do i = nsv + 1, nsv + NGUARD
+      statev(i) = transfer(GUARD_BITS, 1.0_wp)
+    end do
     do p = 1, size(rho)
       associate (Lp => L(:,:,p))
         de(1) = dt * Lp(1,1)
@@ -361,7 +369,8 @@ contains
       noel = int(ctx%first + p - 1, c_int)
       k = 1
       do
-        call increments(p, k, why, pnewdt)
+        call increments(L(:,:,p), stress(:,p), strain(:,p), F(:,:,p), state(1:nsv + NEXTRA, p), &
+          k, why, pnewdt)
         if (why /= WHY_PNEWDT .or. k >= UMAT_MAX_SUB) exit
         ! At least the ratio asked for, and at least twice as many as refused.
         k = min(UMAT_MAX_SUB, max(2 * k, &
@@ -384,42 +393,40 @@ contains
       self%why = code
     end subroutine fail
 
-    ! Particle p's step in k equal sub-increments, on local copies that are stored only when
+    ! One particle's step in k equal sub-increments, on local copies that are stored only when
     ! every sub-increment succeeded (so a refusal or a failure leaves the particle as it was).
     ! why = 0 on success, else WHY_* (pnewdt then holds the UMAT's ratio when it refused).
-    subroutine increments(p, k, why, pnewdt)
-      integer, intent(in) :: p, k
+    ! Explicit-shape dummies: the particle's values are then plain memory, not sections.
+    subroutine increments(Lp, sp, ep, Fp, stp, k, why, pnewdt)
+      real(wp), intent(in) :: Lp(3,3)
+      real(wp), intent(inout) :: sp(6), ep(6), Fp(3,3), stp(nsv + NEXTRA)
+      integer, intent(in) :: k
       integer, intent(out) :: why
       real(wp), intent(out) :: pnewdt
       real(wp) :: h, dsub(6), drot(3,3), F0(3,3), F1(3,3), sig(6), stran(6), dstran(6)
       real(wp) :: s(6), e(6)
-      integer :: j
+      integer :: j, i
       logical :: spin
       h = dt / k
       if (k == 1) then
         dsub = de
       else
-        dsub = strain_increment(h, L(:,:,p))
+        dsub = strain_increment(h, Lp)
       end if
-      s = stress(:,p); e = strain(:,p); F0 = F(:,:,p)
-      statev(1:nsv) = state(1:nsv, p)
-      sse = state(nsv + 1, p); spd = state(nsv + 2, p); scd = state(nsv + 3, p)
+      s = sp; e = ep; F0 = Fp
+      statev(1:nsv) = stp(1:nsv)
+      sse = stp(nsv + 1); spd = stp(nsv + 2); scd = stp(nsv + 3)
       why = 0; pnewdt = 1.0_wp
-      call step_rotation(h, L(:,:,p), drot, spin)
+      call step_rotation(h, Lp, drot, spin)
       do j = 1, k
         if (spin) then
           call rotate(drot, s)
           call rotate(drot, e)
         end if
-        call advance(h, L(:,:,p), F0, F1)
+        call advance(h, Lp, F0, F1)
         call to_abaqus(s, 1.0_wp, sig)
         call to_abaqus(e, 2.0_wp, stran)
         call to_abaqus(dsub, 2.0_wp, dstran)
-        do i = nsv + 1, nsv + NGUARD
-          statev(i) = transfer(GUARD_BITS, 1.0_wp)
-        end do
-        ddsdde(1:ntens * ntens) = 0.0_wp
-        ddsddt = 0.0_wp; drplde = 0.0_wp; rpl = 0.0_wp; drpldt = 0.0_wp
         time = ctx%t + (j - 1) * h
         dtime = h
         pnewdt = 1.0e36_wp ! "no limit": a UMAT lowers it to ask for a smaller increment
@@ -444,9 +451,9 @@ contains
         e = e + dsub
         F0 = F1
       end do
-      stress(:,p) = s; strain(:,p) = e; F(:,:,p) = F0
-      state(1:nsv, p) = statev(1:nsv)
-      state(nsv + 1, p) = sse; state(nsv + 2, p) = spd; state(nsv + 3, p) = scd
+      sp = s; ep = e; Fp = F0
+      stp(1:nsv) = statev(1:nsv)
+      stp(nsv + 1) = sse; stp(nsv + 2) = spd; stp(nsv + 3) = scd
     end subroutine increments
 
     ! The step's rotation Q = (I − ½ΔtW)⁻¹(I + ½ΔtW), W = skew(L), with the formula (and the
@@ -511,11 +518,21 @@ contains
       t(6) = 0.5_wp * (R(1,2) + R(2,1))
     end subroutine rotate
 
-    ! F₁ = F₀ + Δt L F₀ (as advance_f in empm_tensor, here to be inlined).
+    ! F₁ = F₀ + Δt L F₀ (as advance_f in empm_tensor, here to be inlined). In plane strain L
+    ! and F have no 13, 23, 31, 32 entries and F₃₃ stays: only the in-plane block changes.
     pure subroutine advance(dt, L, F0, F1)
       real(wp), intent(in) :: dt, L(3,3), F0(3,3)
       real(wp), intent(out) :: F1(3,3)
       integer :: i, j
+      if (ntens == 4) then
+        F1 = F0
+        do j = 1, 2
+          do i = 1, 2
+            F1(i,j) = F0(i,j) + dt * (L(i,1) * F0(1,j) + L(i,2) * F0(2,j))
+          end do
+        end do
+        return
+      end if
       do j = 1, 3
         do i = 1, 3
           F1(i,j) = F0(i,j) + dt * (L(i,1) * F0(1,j) + L(i,2) * F0(2,j) + L(i,3) * F0(3,j))
