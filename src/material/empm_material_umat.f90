@@ -15,7 +15,7 @@
 !>    spacing, COORDS = 0 (the material interface carries no positions), TEMP = DTEMP = 0;
 !> 4. checks the result: a non-finite STRESS, a write past STATEV(NSTATV) (guard values after
 !>    the state variables) or PNEWDT < 1 even at the smallest sub-increment fail the particle;
-!>    PNEWDT < 1 otherwise restores the particle and retries the step in k equal sub-increments
+!>    PNEWDT < 1 otherwise discards the attempt (it ran on copies) and retries the step in k equal sub-increments
 !>    (k ≥ 2/PNEWDT rounded up, doubled at each refusal, at most MAX_SUB), counted in the state
 !>    variable `umat_cuts`.
 !>
@@ -317,7 +317,7 @@ contains
   end subroutine um_update
 
   ! The particles of a batch, one after the other; a refused increment (PNEWDT < 1) is retried
-  ! from the particle's saved state in more sub-increments.
+  ! from the particle's unchanged state in more sub-increments.
   subroutine update_batch(self, umat, dt, L, F, strain, stress, state, rho, ctx, info)
     class(empm_umat_t), intent(in) :: self
     procedure(umat_iface), pointer, intent(in) :: umat
