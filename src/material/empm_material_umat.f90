@@ -15,9 +15,9 @@
 !>    spacing, COORDS = 0 (the material interface carries no positions), TEMP = DTEMP = 0;
 !> 4. checks the result: a non-finite STRESS, a write past STATEV(NSTATV) (guard values after
 !>    the state variables) or PNEWDT < 1 even at the smallest sub-increment fail the particle;
-!>    PNEWDT < 1 otherwise discards the attempt (it ran on copies) and retries the step in k equal sub-increments
-!>    (k ≥ 2/PNEWDT rounded up, doubled at each refusal, at most MAX_SUB), counted in the state
-!>    variable `umat_cuts`.
+!>    PNEWDT < 1 otherwise discards the attempt (it ran on copies) and retries the step in k
+!>    equal sub-increments (k ≥ k_previous/PNEWDT and ≥ 2 k_previous, at most UMAT_MAX_SUB); a
+!>    particle whose step was cut adds 1 to its state variable `umat_cuts`.
 !>
 !> The density follows ρ ← ρ/(1 + tr Δε) as in the native rate-form models. State variables:
 !> STATEV(1..NSTATV) as `statev1..statevN`, then SSE, SPD, SCD (carried between increments, as
