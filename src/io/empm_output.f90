@@ -112,7 +112,8 @@ contains
     call h5_attr(g, 'time', model%t, ierr)
     call h5_attr(g, 'step', model%step, ierr)
     call write_state(g, model%pts, ierr)
-    call write_state_vars(g, model%pts%state, model%pts%mat, snames, scol, ierr)
+    call write_state_vars(g, model%pts%state(:, 1:model%pts%np), model%pts%mat(1:model%pts%np), &
+      snames, scol, ierr)
     call write_xdmf_fields(g, model%pts%x(:, 1:model%pts%np), model%pts%x0(:, 1:model%pts%np), &
       model%pts%v(:, 1:model%pts%np), model%pts%stress(:, 1:model%pts%np), &
       model%pts%strain(:, 1:model%pts%np), ierr)

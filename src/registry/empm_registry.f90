@@ -28,8 +28,10 @@ module empm_registry
   use empm_material, only: empm_material_t
   use empm_material_linear_elastic, only: empm_linear_elastic_t
   use empm_material_neohookean, only: empm_neohookean_t
+  use empm_material_drucker_prager, only: empm_drucker_prager_t
   use empm_material_mohr_coulomb, only: empm_mohr_coulomb_t
   use empm_material_camclay, only: empm_camclay_t
+  use empm_material_umat, only: empm_umat_t
   use empm_integrator, only: empm_integrator_t
   use empm_integrator_euler, only: empm_euler_t, EULER_USF, EULER_USL, EULER_MUSL
   use empm_integrator_pc, only: empm_pc_t, PC_PUBLISHED, PC_NEWMARK
@@ -79,8 +81,10 @@ contains
     call reg%add_shape(empm_shape_lme_t())
     call reg%add_material(empm_linear_elastic_t())
     call reg%add_material(empm_neohookean_t())
+    call reg%add_material(empm_drucker_prager_t())
     call reg%add_material(empm_mohr_coulomb_t())
     call reg%add_material(empm_camclay_t())
+    call reg%add_material(empm_umat_t())
     call reg%add_integrator(empm_euler_t(variant=EULER_USF))
     call reg%add_integrator(empm_euler_t(variant=EULER_USL))
     call reg%add_integrator(empm_euler_t(variant=EULER_MUSL))

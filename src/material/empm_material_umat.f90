@@ -1,0 +1,611 @@
+!> The `umat` material: an adapter that calls an Abaqus-style user material subroutine (UMAT)
+!> loaded at run time from a shared library named in the case file.
+!>
+!> The library is loaded once, in `configure` ([[empm_dynlib]]); a missing library or symbol is
+!> an input error quoting the loader's message. Each step, for each particle, the adapter
+!>
+!> 1. rotates the stress and the total strain with the step's Cayley rotation Q (the formula and
+!>    operations of [[jaumann_rotate]], as the native rate-form models) and passes Q as DROT;
+!> 2. converts to the Abaqus conventions: components 11, 22, 33, 12, 13, 23 (empm stores xx, yy,
+!>    zz, yz, xz, xy), engineering shear strains in STRAN and DSTRAN; 3D: NDI = 3, NSHR = 3;
+!>    2D plane strain and 1D uniaxial strain: NDI = 3, NSHR = 1 (in 1D the shears stay zero);
+!> 3. calls the UMAT with Δε = Δt sym(L), DFGRD0 = F at the start, DFGRD1 = F advanced with L
+!>    (F₁ = F₀ + Δt L F₀), TIME = t (step time = total time), DTIME = Δt, KSTEP = 1, KINC = the step
+!>    number, NOEL = the particle index, NPT = LAYER = KSPT = 1, CELENT = the smallest grid
+!>    spacing, COORDS = 0 (the material interface carries no positions), TEMP = DTEMP = 0;
+!> 4. checks the result: a non-finite STRESS, a write past STATEV(NSTATV) (guard values after
+!>    the state variables) or PNEWDT < 1 even at the smallest sub-increment fail the particle;
+!>    PNEWDT < 1 otherwise discards the attempt (it ran on copies) and retries the step in k
+!>    equal sub-increments (k ≥ k_previous/PNEWDT and ≥ 2 k_previous, at most UMAT_MAX_SUB); a
+!>    particle whose step was cut adds 1 to its state variable `umat_cuts`.
+!>
+!> The density follows ρ ← ρ/(1 + tr Δε) as in the native rate-form models. State variables:
+!> STATEV(1..NSTATV) as `statev1..statevN`, then SSE, SPD, SCD (carried between increments, as
+!> Abaqus does) as `umat_sse`, `umat_spd`, `umat_scd`, then `umat_cuts`. The stored energy
+!> density reported for the energy balance is SSE (energy per unit volume in the Abaqus
+!> convention). The CFL wave speed comes from `E`/`nu` or `wave_modulus` given in the case file:
+!> the adapter cannot know the UMAT's stiffness before calling it.
+module empm_material_umat
+  use, intrinsic :: iso_c_binding, only: c_ptr, c_funptr, c_double, c_int, c_char, c_size_t, &
+    c_f_procpointer, c_null_ptr, c_null_funptr, c_associated
+  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: iso_fortran_env, only: int64
+  use empm_kinds, only: wp
+  use empm_error, only: empm_error_t
+  use empm_params, only: empm_param_t, empm_param, PARAM_REAL, PARAM_INT, PARAM_STR, &
+    PARAM_LOGICAL
+  use empm_namelist, only: empm_group_t
+  use empm_material, only: empm_material_t, empm_material_ctx_t, STATE_NAME_LEN
+  use empm_material_linear_elastic, only: empm_lame
+  use empm_plasticity, only: strain_increment
+  use empm_dynlib, only: empm_dynlib_open, empm_dynlib_symbol
+  implicit none
+  private
+  public :: empm_umat_t, UMAT_MAX_PROPS, UMAT_MAX_SUB
+
+  integer, parameter :: UMAT_MAX_PROPS = 100 !! most material constants (PROPS) in a case file
+  integer, parameter :: UMAT_MAX_SUB = 64    !! most sub-increments of a step cut by PNEWDT
+  integer, parameter :: MAX_STATEV = 1000    !! most state variables (NSTATV)
+  integer, parameter :: NGUARD = 8           !! guard values after STATEV(NSTATV)
+  integer, parameter :: NEXTRA = 4           !! sse, spd, scd, cuts after the STATEV rows
+  !> Guard value: a quiet NaN with a payload no arithmetic produces, compared bit for bit.
+  integer(int64), parameter :: GUARD_BITS = int(z'7FF8E3A1C0DE5EED', int64)
+
+  ! Why the last failing particle failed (for failure_text).
+  integer, parameter :: WHY_VOLUME = 1, WHY_NONFINITE = 2, WHY_NSTATV = 3, WHY_PNEWDT = 4
+
+  !> The Abaqus UMAT argument list as gfortran's external `SUBROUTINE UMAT` receives it: every
+  !> argument by reference, CMNAME's length appended by value (size_t, gfortran ≥ 8).
+  abstract interface
+    subroutine umat_iface(stress, statev, ddsdde, sse, spd, scd, rpl, ddsddt, drplde, drpldt, &
+        stran, dstran, time, dtime, temp, dtemp, predef, dpred, cmname, ndi, nshr, ntens, &
+        nstatv, props, nprops, coords, drot, pnewdt, celent, dfgrd0, dfgrd1, noel, npt, layer, &
+        kspt, kstep, kinc, cmname_len) bind(C)
+      import :: c_double, c_int, c_char, c_size_t
+      real(c_double), intent(inout) :: stress(*)   !! STRESS(NTENS)
+      real(c_double), intent(inout) :: statev(*)   !! STATEV(NSTATV)
+      real(c_double), intent(inout) :: ddsdde(*)   !! DDSDDE(NTENS, NTENS)
+      real(c_double), intent(inout) :: sse         !! specific elastic strain energy
+      real(c_double), intent(inout) :: spd         !! plastic dissipation
+      real(c_double), intent(inout) :: scd         !! creep dissipation
+      real(c_double), intent(inout) :: rpl         !! volumetric heat generation
+      real(c_double), intent(inout) :: ddsddt(*)   !! DDSDDT(NTENS)
+      real(c_double), intent(inout) :: drplde(*)   !! DRPLDE(NTENS)
+      real(c_double), intent(inout) :: drpldt      !! d RPL / d T
+      real(c_double), intent(inout) :: stran(*)    !! STRAN(NTENS)
+      real(c_double), intent(inout) :: dstran(*)   !! DSTRAN(NTENS)
+      real(c_double), intent(inout) :: time(*)     !! TIME(2)
+      real(c_double), intent(inout) :: dtime       !! time increment
+      real(c_double), intent(inout) :: temp        !! temperature
+      real(c_double), intent(inout) :: dtemp       !! its increment
+      real(c_double), intent(inout) :: predef(*)   !! predefined fields
+      real(c_double), intent(inout) :: dpred(*)    !! their increments
+      character(kind=c_char), intent(inout) :: cmname(*) !! CHARACTER*80 CMNAME
+      integer(c_int), intent(inout) :: ndi         !! direct components
+      integer(c_int), intent(inout) :: nshr        !! shear components
+      integer(c_int), intent(inout) :: ntens       !! NDI + NSHR
+      integer(c_int), intent(inout) :: nstatv      !! state variables
+      real(c_double), intent(inout) :: props(*)    !! PROPS(NPROPS) (a copy)
+      integer(c_int), intent(inout) :: nprops      !! material constants
+      real(c_double), intent(inout) :: coords(*)   !! COORDS(3)
+      real(c_double), intent(inout) :: drot(*)     !! DROT(3,3)
+      real(c_double), intent(inout) :: pnewdt      !! suggested Δt ratio
+      real(c_double), intent(inout) :: celent      !! characteristic length
+      real(c_double), intent(inout) :: dfgrd0(*)   !! DFGRD0(3,3)
+      real(c_double), intent(inout) :: dfgrd1(*)   !! DFGRD1(3,3)
+      integer(c_int), intent(inout) :: noel        !! element (particle) number
+      integer(c_int), intent(inout) :: npt         !! integration point
+      integer(c_int), intent(inout) :: layer       !! layer
+      integer(c_int), intent(inout) :: kspt        !! section point
+      integer(c_int), intent(inout) :: kstep       !! step number
+      integer(c_int), intent(inout) :: kinc        !! increment number
+      integer(c_size_t), value :: cmname_len       !! hidden length of CMNAME
+    end subroutine umat_iface
+  end interface
+
+  !> Adapter to a user material subroutine with the Abaqus UMAT argument list.
+  type, extends(empm_material_t) :: empm_umat_t
+    character(len=:), allocatable :: library   !! library path as opened
+    character(len=:), allocatable :: symbol    !! symbol name
+    character(len=80) :: cmname = ' '          !! CMNAME: the material's name, upper case
+    real(wp), allocatable :: props(:)          !! PROPS
+    integer :: nstatv = 0                      !! NSTATV
+    logical :: thread_safe = .false.           !! the UMAT may run concurrently
+    real(wp) :: lambda = 0.0_wp                !! Lamé λ for the CFL bound [Pa]
+    real(wp) :: mu = 0.0_wp                    !! shear modulus for the CFL bound [Pa]
+    type(c_ptr) :: handle = c_null_ptr         !! loaded library (kept open for the run)
+    type(c_funptr) :: fun = c_null_funptr      !! the UMAT
+    integer, pointer :: why => null()          !! reason of the last failure (WHY_*); a
+                                               !! pointer so that `update` (self intent(in))
+                                               !! can record it
+  contains
+    procedure :: configure => um_configure
+    procedure :: family => um_family
+    procedure :: summary => um_summary
+    procedure :: params => um_params
+    procedure :: update => um_update
+    procedure :: wave_speed => um_wave_speed
+    procedure :: energy_density => um_energy_density
+    procedure :: state_names => um_state_names
+    procedure :: failure_text => um_failure_text
+  end type empm_umat_t
+
+contains
+
+  !> Registry name "umat".
+  pure function um_family(self) result(s)
+    class(empm_umat_t), intent(in) :: self !! material
+    character(len=:), allocatable :: s     !! "umat"
+    associate (unused_ => self); end associate
+    s = 'umat'
+  end function um_family
+
+  !> One-line description.
+  pure function um_summary(self) result(s)
+    class(empm_umat_t), intent(in) :: self !! material
+    character(len=:), allocatable :: s     !! summary
+    associate (unused_ => self); end associate
+    s = 'user material subroutine with the Abaqus UMAT argument list, loaded from a shared ' &
+      //'library at run time'
+  end function um_summary
+
+  !> Parameters: `library`, `symbol`, `props`, `nstatv`, `density`, `E`, `nu`, `wave_modulus`,
+  !> `thread_safe`.
+  pure function um_params(self) result(p)
+    class(empm_umat_t), intent(in) :: self !! material
+    type(empm_param_t), allocatable :: p(:) !! declarations
+    associate (unused_ => self); end associate
+    p = [ &
+      empm_param('library', PARAM_STR, '-', "shared library holding the UMAT, relative to " &
+        //"the case file's folder (or absolute)"), &
+      empm_param('symbol', PARAM_STR, '-', "external name of the subroutine in the library " &
+        //"(gfortran names SUBROUTINE UMAT 'umat_')", default="'umat_'"), &
+      empm_param('props', PARAM_REAL, '-', 'material constants passed as PROPS (NPROPS = ' &
+        //'the number given)', count=UMAT_MAX_PROPS, optional=.true.), &
+      empm_param('nstatv', PARAM_INT, '-', 'number of state variables STATEV (output as ' &
+        //'state/statev1..)', default='0', lo=0.0_wp, hi=real(MAX_STATEV, wp)), &
+      empm_param('density', PARAM_REAL, 'kg/m3', 'initial density', lo=1.0e-30_wp, &
+        hi=1.0e30_wp), &
+      empm_param('E', PARAM_REAL, 'Pa', "Young's modulus bounding the UMAT's stiffness, for " &
+        //'the CFL time step (give E or wave_modulus)', lo=0.0_wp, lo_open=.true., &
+        hi=1.0e30_wp, optional=.true.), &
+      empm_param('nu', PARAM_REAL, '-', "Poisson's ratio with E, for the CFL time step", &
+        default='0', lo=-1.0_wp, hi=0.5_wp, lo_open=.true., hi_open=.true.), &
+      empm_param('wave_modulus', PARAM_REAL, 'Pa', 'P-wave modulus bounding the UMAT''s ' &
+        //'stiffness (lambda + 2 mu), for the CFL time step, instead of E and nu', &
+        lo=0.0_wp, lo_open=.true., hi=1.0e30_wp, optional=.true.), &
+      empm_param('thread_safe', PARAM_LOGICAL, '-', 'the UMAT may be called concurrently ' &
+        //'(no SAVEd or COMMON data); when false the calls are serialised', &
+        default='.false.')]
+  end function um_params
+
+  !> Read the keys, load the library and look the symbol up.
+  subroutine um_configure(self, group, err)
+    class(empm_umat_t), intent(inout) :: self  !! material
+    type(empm_group_t), intent(inout) :: group !! the `&material` group
+    type(empm_error_t), intent(inout) :: err   !! set on a missing or invalid value, a missing
+                                               !! library or symbol
+    type(empm_param_t), allocatable :: p(:)
+    character(len=:), allocatable :: lib, msg, name
+    real(wp) :: props(UMAT_MAX_PROPS), E, nu, m
+    integer :: nprops, i
+    allocate(p, source=self%params())
+    lib = ''
+    self%symbol = 'umat_'
+    props = 0.0_wp; nprops = 0
+    E = 0.0_wp; nu = 0.0_wp; m = 0.0_wp
+    call group%get(p(1), lib, err)
+    call group%get(p(2), self%symbol, err)
+    call group%get(p(3), props, nprops, err)
+    call group%get(p(4), self%nstatv, err)
+    call group%get(p(5), self%rho0, err)
+    call group%get(p(6), E, err)
+    call group%get(p(7), nu, err)
+    call group%get(p(8), m, err)
+    call group%get(p(9), self%thread_safe, err)
+    if (err%code /= 0) return
+    self%props = props(1:nprops)
+    ! The stiffness bound for the CFL step: exactly one of E (with nu) and wave_modulus.
+    if (group%has('wave_modulus') .and. group%has('E')) then
+      call group%fail(err, 'wave_modulus', 'give either E (with nu) or wave_modulus, not both')
+      return
+    else if (.not. (group%has('wave_modulus') .or. group%has('E'))) then
+      call group%fail(err, '', 'E (with nu) or wave_modulus is required: the CFL time step ' &
+        //'needs a bound on the UMAT''s stiffness')
+      return
+    end if
+    if (group%has('E')) then
+      call empm_lame(E, nu, self%lambda, self%mu)
+    else
+      self%lambda = m; self%mu = 0.0_wp
+    end if
+    ! CMNAME: the material's name, upper case as Abaqus passes it.
+    name = ''
+    call group%get(empm_param('name', PARAM_STR, '-', 'material name', optional=.true.), &
+      name, err)
+    if (err%code /= 0) return
+    self%cmname = name
+    do i = 1, len(self%cmname)
+      if (self%cmname(i:i) >= 'a' .and. self%cmname(i:i) <= 'z') &
+        self%cmname(i:i) = achar(iachar(self%cmname(i:i)) - 32)
+    end do
+    self%library = case_relative(group%file, lib)
+    call empm_dynlib_open(self%library, self%handle, msg)
+    if (len(msg) > 0) then
+      call group%fail(err, 'library', msg)
+      return
+    end if
+    call empm_dynlib_symbol(self%handle, self%symbol, self%fun, msg)
+    if (len(msg) > 0) then
+      call group%fail(err, 'symbol', msg)
+      return
+    end if
+    allocate(self%why)
+    self%why = 0
+  end subroutine um_configure
+
+  ! `file` relative to the folder of the case file (as `&particles file`); './' for a case file
+  ! in the working folder, so that dlopen never searches the system's library path.
+  pure function case_relative(case_file, file) result(path)
+    character(len=:), allocatable, intent(in) :: case_file
+    character(len=*), intent(in) :: file
+    character(len=:), allocatable :: path
+    integer :: s
+    path = trim(adjustl(file))
+    if (len(path) == 0) return
+    if (path(1:1) == '/') return
+    s = 0
+    if (allocated(case_file)) s = index(case_file, '/', back=.true.)
+    if (s > 0) then
+      path = case_file(1:s)//path
+    else
+      path = './'//path
+    end if
+  end function case_relative
+
+  !> State variables: `statev1..statevN`, `umat_sse`, `umat_spd`, `umat_scd`, `umat_cuts`.
+  pure subroutine um_state_names(self, names)
+    class(empm_umat_t), intent(in) :: self                              !! material
+    character(len=STATE_NAME_LEN), allocatable, intent(out) :: names(:) !! names
+    integer :: i
+    character(len=12) :: buf
+    allocate(names(self%nstatv + NEXTRA))
+    do i = 1, self%nstatv
+      write(buf, '(i0)') i
+      names(i) = 'statev'//trim(buf)
+    end do
+    names(self%nstatv + 1) = 'umat_sse'
+    names(self%nstatv + 2) = 'umat_spd'
+    names(self%nstatv + 3) = 'umat_scd'
+    names(self%nstatv + 4) = 'umat_cuts'
+  end subroutine um_state_names
+
+  !> Update `n = size(rho)` particles by calling the UMAT (see the module notes). Unless
+  !> `thread_safe`, the batch's calls run in one critical section (legacy UMATs keep SAVEd data).
+  !> `info = k > 0`: particle k failed (the first such; its state is left as at the start of the
+  !> step, the others are updated); `info = -1`: array extents disagree with n.
+  subroutine um_update(self, dt, L, F, strain, stress, state, rho, ctx, info)
+    class(empm_umat_t), intent(in) :: self                 !! material
+    real(wp), intent(in) :: dt                             !! time step [s]
+    real(wp), intent(in), contiguous :: L(:,:,:)           !! velocity gradient (3,3,n) [1/s]
+    real(wp), intent(inout), contiguous :: F(:,:,:)        !! deformation gradient (3,3,n)
+    real(wp), intent(inout), contiguous :: strain(:,:)     !! strain, Voigt (6,n), rotated with
+                                                           !! the stress (Abaqus's STRAN)
+    real(wp), intent(inout), contiguous :: stress(:,:)     !! Cauchy stress, Voigt (6,n) [Pa]
+    real(wp), intent(inout), contiguous :: state(:,:)      !! STATEV, SSE, SPD, SCD, cuts
+    real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
+    type(empm_material_ctx_t), intent(in) :: ctx           !! time, step, batch position
+    integer, intent(out) :: info                           !! 0 ok; k > 0 particle k failed
+    procedure(umat_iface), pointer :: umat
+    integer :: n
+    info = 0
+    n = size(rho)
+    if (size(L, 3) /= n .or. size(F, 3) /= n .or. size(strain, 2) /= n &
+        .or. size(stress, 2) /= n .or. size(state, 2) /= n &
+        .or. size(state, 1) < self%nstatv + NEXTRA) then
+      info = -1
+      return
+    end if
+    call c_f_procpointer(self%fun, umat)
+    if (self%thread_safe) then
+      call update_batch(self, umat, dt, L, F, strain, stress, state, rho, ctx, info)
+    else
+      !$omp critical (empm_umat_calls)
+      call update_batch(self, umat, dt, L, F, strain, stress, state, rho, ctx, info)
+      !$omp end critical (empm_umat_calls)
+    end if
+  end subroutine um_update
+
+  ! The particles of a batch, one after the other; a refused increment (PNEWDT < 1) is retried
+  ! from the particle's unchanged state in more sub-increments.
+  subroutine update_batch(self, umat, dt, L, F, strain, stress, state, rho, ctx, info)
+    class(empm_umat_t), intent(in) :: self
+    procedure(umat_iface), pointer, intent(in) :: umat
+    real(wp), intent(in) :: dt
+    real(wp), intent(in), contiguous :: L(:,:,:)
+    real(wp), intent(inout), contiguous :: F(:,:,:), strain(:,:), stress(:,:), state(:,:), rho(:)
+    type(empm_material_ctx_t), intent(in) :: ctx
+    integer, intent(inout) :: info
+    ! Fixed sizes: no allocation in the time loop, and an overrun of STATEV past the guards
+    ! still lands in this array (up to MAX_STATEV + NGUARD values).
+    real(wp) :: statev(MAX_STATEV + NGUARD), props(UMAT_MAX_PROPS)
+    real(wp) :: de(6), tr, pnewdt, time(2), sse, spd, scd, rpl, ddsddt(6), drplde(6), drpldt
+    real(wp) :: temp, dtemp, predef(1), dpred(1), coords(3), celent, dtime, ddsdde(36)
+    character(len=80) :: cmname
+    integer(c_int) :: ndi, nshr, ntens, nstatv, nprops, noel, npt, layer, kspt, kstep, kinc
+    integer :: p, k, why, nsv, i
+    nsv = self%nstatv
+    ! Copies: the UMAT receives them by reference and a careless one may write to them.
+    props = 0.0_wp
+    props(1:size(self%props)) = self%props
+    cmname = self%cmname
+    ndi = 3
+    nshr = merge(3, 1, ctx%ndim == 3)
+    ntens = ndi + nshr
+    nstatv = int(nsv, c_int); nprops = int(size(self%props), c_int)
+    npt = 1; layer = 1; kspt = 1; kstep = 1; kinc = int(ctx%step, c_int)
+    coords = 0.0_wp; celent = ctx%h; temp = 0.0_wp; dtemp = 0.0_wp
+    predef = 0.0_wp; dpred = 0.0_wp
+    ! Outputs the adapter does not use, and the guards after STATEV(NSTATV): set once per
+    ! batch (the guards are checked after every call, and a changed one ends the batch's use).
+    ddsdde = 0.0_wp; ddsddt = 0.0_wp; drplde = 0.0_wp; rpl = 0.0_wp; drpldt = 0.0_wp
+    do i = nsv + 1, nsv + NGUARD
+      statev(i) = transfer(GUARD_BITS, 1.0_wp)
+    end do
+    do p = 1, size(rho)
+      associate (Lp => L(:,:,p))
+        de(1) = dt * Lp(1,1)
+        de(2) = dt * Lp(2,2)
+        de(3) = dt * Lp(3,3)
+        de(4) = 0.5_wp * dt * (Lp(2,3) + Lp(3,2))
+        de(5) = 0.5_wp * dt * (Lp(1,3) + Lp(3,1))
+        de(6) = 0.5_wp * dt * (Lp(1,2) + Lp(2,1))
+      end associate
+      tr = de(1) + de(2) + de(3)
+      if (1.0_wp + tr <= 0.0_wp) then ! as the native models: an inverted particle
+        call fail(p, WHY_VOLUME)
+        cycle
+      end if
+      noel = int(ctx%first + p - 1, c_int)
+      k = 1
+      do
+        call increments(L(:,:,p), stress(:,p), strain(:,p), F(:,:,p), state(1:nsv + NEXTRA, p), &
+          k, why, pnewdt)
+        if (why /= WHY_PNEWDT .or. k >= UMAT_MAX_SUB) exit
+        ! At least the ratio asked for, and at least twice as many as refused.
+        k = min(UMAT_MAX_SUB, max(2 * k, &
+          ceiling(real(k, wp) / max(pnewdt, 1.0_wp / UMAT_MAX_SUB))))
+      end do
+      if (why /= 0) then
+        call fail(p, why)
+        cycle
+      end if
+      if (k > 1) state(nsv + NEXTRA, p) = state(nsv + NEXTRA, p) + 1.0_wp
+      rho(p) = rho(p) / (1.0_wp + tr)
+    end do
+
+  contains
+
+    subroutine fail(p, code)
+      integer, intent(in) :: p, code
+      if (info == 0) info = p
+      !$omp atomic write
+      self%why = code
+    end subroutine fail
+
+    ! One particle's step in k equal sub-increments, on local copies that are stored only when
+    ! every sub-increment succeeded (so a refusal or a failure leaves the particle as it was).
+    ! why = 0 on success, else WHY_* (pnewdt then holds the UMAT's ratio when it refused).
+    ! Explicit-shape dummies: the particle's values are then plain memory, not sections.
+    subroutine increments(Lp, sp, ep, Fp, stp, k, why, pnewdt)
+      real(wp), intent(in) :: Lp(3,3)
+      real(wp), intent(inout) :: sp(6), ep(6), Fp(3,3), stp(nsv + NEXTRA)
+      integer, intent(in) :: k
+      integer, intent(out) :: why
+      real(wp), intent(out) :: pnewdt
+      real(wp) :: h, dsub(6), drot(3,3), F0(3,3), F1(3,3), sig(6), stran(6), dstran(6)
+      real(wp) :: s(6), e(6)
+      integer :: j, i
+      logical :: spin
+      h = dt / k
+      if (k == 1) then
+        dsub = de
+      else
+        dsub = strain_increment(h, Lp)
+      end if
+      s = sp; e = ep; F0 = Fp
+      statev(1:nsv) = stp(1:nsv)
+      sse = stp(nsv + 1); spd = stp(nsv + 2); scd = stp(nsv + 3)
+      why = 0; pnewdt = 1.0_wp
+      call step_rotation(h, Lp, drot, spin)
+      do j = 1, k
+        if (spin) then
+          call rotate(drot, s)
+          call rotate(drot, e)
+        end if
+        call advance(h, Lp, F0, F1)
+        call to_abaqus(s, 1.0_wp, sig)
+        call to_abaqus(e, 2.0_wp, stran)
+        call to_abaqus(dsub, 2.0_wp, dstran)
+        time = ctx%t + (j - 1) * h
+        dtime = h
+        pnewdt = 1.0e36_wp ! "no limit": a UMAT lowers it to ask for a smaller increment
+        call umat(sig, statev, ddsdde, sse, spd, scd, rpl, ddsddt, drplde, drpldt, stran, &
+          dstran, time, dtime, temp, dtemp, predef, dpred, cmname, ndi, nshr, ntens, &
+          nstatv, props, nprops, coords, drot, pnewdt, celent, F0, F1, noel, npt, &
+          layer, kspt, kstep, kinc, int(len(cmname), c_size_t))
+        do i = nsv + 1, nsv + NGUARD
+          if (transfer(statev(i), GUARD_BITS) /= GUARD_BITS) then
+            why = WHY_NSTATV; return
+          end if
+        end do
+        do i = 1, ntens
+          if (.not. ieee_is_finite(sig(i))) then
+            why = WHY_NONFINITE; return
+          end if
+        end do
+        if (pnewdt < 1.0_wp) then
+          why = WHY_PNEWDT; return
+        end if
+        call from_abaqus(sig, s)
+        e = e + dsub
+        F0 = F1
+      end do
+      sp = s; ep = e; Fp = F0
+      stp(1:nsv) = statev(1:nsv)
+      stp(nsv + 1) = sse; stp(nsv + 2) = spd; stp(nsv + 3) = scd
+    end subroutine increments
+
+    ! The step's rotation Q = (I − ½ΔtW)⁻¹(I + ½ΔtW), W = skew(L), with the formula (and the
+    ! operations) of jaumann_rotate in empm_plasticity, which the native rate-form models use:
+    ! the UMAT's stress is rotated exactly as theirs. spin = false when W = 0 (Q = I).
+    pure subroutine step_rotation(dt, L, Q, spin)
+      real(wp), intent(in) :: dt, L(3,3)
+      real(wp), intent(out) :: Q(3,3)
+      logical, intent(out) :: spin
+      real(wp) :: a(3), c
+      integer :: i, j
+      a(1) = 0.25_wp * dt * (L(3,2) - L(2,3))
+      a(2) = 0.25_wp * dt * (L(1,3) - L(3,1))
+      a(3) = 0.25_wp * dt * (L(2,1) - L(1,2))
+      Q = 0.0_wp
+      Q(1,1) = 1.0_wp; Q(2,2) = 1.0_wp; Q(3,3) = 1.0_wp
+      spin = .not. (a(1) == 0.0_wp .and. a(2) == 0.0_wp .and. a(3) == 0.0_wp)
+      if (.not. spin) return
+      c = 2.0_wp / (1.0_wp + a(1)**2 + a(2)**2 + a(3)**2)
+      do j = 1, 3
+        do i = 1, 3
+          Q(i,j) = c * a(i) * a(j)
+        end do
+      end do
+      Q(1,1) = Q(1,1) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
+      Q(2,2) = Q(2,2) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
+      Q(3,3) = Q(3,3) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
+      Q(1,2) = Q(1,2) - c * a(3); Q(2,1) = Q(2,1) + c * a(3)
+      Q(1,3) = Q(1,3) + c * a(2); Q(3,1) = Q(3,1) - c * a(2)
+      Q(2,3) = Q(2,3) - c * a(1); Q(3,2) = Q(3,2) + c * a(1)
+    end subroutine step_rotation
+
+    ! t ← Q t Qᵀ for a symmetric tensor in Voigt form (tensor shears), as jaumann_rotate does
+    ! (Q (t Qᵀ), then the symmetric part). In plane strain (ntens = 4) Q and t have no 13, 23
+    ! entries: the terms dropped are exact zeros, so the sums are the same.
+    pure subroutine rotate(Q, t)
+      real(wp), intent(in) :: Q(3,3)
+      real(wp), intent(inout) :: t(6)
+      real(wp) :: T3(3,3), R(3,3), M(3,3)
+      if (ntens == 4) then
+        M(1,1) = t(1) * Q(1,1) + t(6) * Q(1,2)
+        M(1,2) = t(1) * Q(2,1) + t(6) * Q(2,2)
+        M(2,1) = t(6) * Q(1,1) + t(2) * Q(1,2)
+        M(2,2) = t(6) * Q(2,1) + t(2) * Q(2,2)
+        R(1,1) = Q(1,1) * M(1,1) + Q(1,2) * M(2,1)
+        R(2,2) = Q(2,1) * M(1,2) + Q(2,2) * M(2,2)
+        R(1,2) = Q(1,1) * M(1,2) + Q(1,2) * M(2,2)
+        R(2,1) = Q(2,1) * M(1,1) + Q(2,2) * M(2,1)
+        t(1) = R(1,1); t(2) = R(2,2)
+        t(3) = Q(3,3) * (t(3) * Q(3,3))
+        t(6) = 0.5_wp * (R(1,2) + R(2,1))
+        return
+      end if
+      T3(1,1) = t(1); T3(2,2) = t(2); T3(3,3) = t(3)
+      T3(2,3) = t(4); T3(3,2) = t(4)
+      T3(1,3) = t(5); T3(3,1) = t(5)
+      T3(1,2) = t(6); T3(2,1) = t(6)
+      R = matmul(Q, matmul(T3, transpose(Q)))
+      t(1) = R(1,1); t(2) = R(2,2); t(3) = R(3,3)
+      t(4) = 0.5_wp * (R(2,3) + R(3,2))
+      t(5) = 0.5_wp * (R(1,3) + R(3,1))
+      t(6) = 0.5_wp * (R(1,2) + R(2,1))
+    end subroutine rotate
+
+    ! F₁ = F₀ + Δt L F₀ (as advance_f in empm_tensor, here to be inlined). In plane strain L
+    ! and F have no 13, 23, 31, 32 entries and F₃₃ stays: only the in-plane block changes.
+    pure subroutine advance(dt, L, F0, F1)
+      real(wp), intent(in) :: dt, L(3,3), F0(3,3)
+      real(wp), intent(out) :: F1(3,3)
+      integer :: i, j
+      if (ntens == 4) then
+        F1 = F0
+        do j = 1, 2
+          do i = 1, 2
+            F1(i,j) = F0(i,j) + dt * (L(i,1) * F0(1,j) + L(i,2) * F0(2,j))
+          end do
+        end do
+        return
+      end if
+      do j = 1, 3
+        do i = 1, 3
+          F1(i,j) = F0(i,j) + dt * (L(i,1) * F0(1,j) + L(i,2) * F0(2,j) + L(i,3) * F0(3,j))
+        end do
+      end do
+    end subroutine advance
+
+    ! empm Voigt (xx, yy, zz, yz, xz, xy) → Abaqus (11, 22, 33, 12, 13, 23) with the shears
+    ! scaled by `g` (2 for engineering strains); NTENS = 4 keeps 12 only.
+    pure subroutine to_abaqus(v, g, a)
+      real(wp), intent(in) :: v(6), g
+      real(wp), intent(out) :: a(6)
+      a(1:3) = v(1:3)
+      a(4) = g * v(6)
+      a(5) = g * v(5)
+      a(6) = g * v(4)
+      if (ntens == 4) a(5:6) = 0.0_wp
+    end subroutine to_abaqus
+
+    pure subroutine from_abaqus(a, v)
+      real(wp), intent(in) :: a(6)
+      real(wp), intent(inout) :: v(6)
+      v(1:3) = a(1:3)
+      v(6) = a(4)
+      if (ntens == 6) then
+        v(5) = a(5); v(4) = a(6)
+      end if
+    end subroutine from_abaqus
+  end subroutine update_batch
+
+  !> P-wave speed sqrt((λ + 2μ)/ρ) from the case's `E`/`nu` or `wave_modulus` [m/s].
+  pure real(wp) function um_wave_speed(self, rho)
+    class(empm_umat_t), intent(in) :: self !! material
+    real(wp), intent(in) :: rho            !! current density [kg/m³]
+    um_wave_speed = sqrt((self%lambda + 2.0_wp * self%mu) / rho)
+  end function um_wave_speed
+
+  !> Stored energy density: the UMAT's SSE (energy per unit volume, Abaqus's convention).
+  pure subroutine um_energy_density(self, F, strain, stress, state, psi)
+    class(empm_umat_t), intent(in) :: self !! material
+    real(wp), intent(in) :: F(:,:,:)       !! deformation gradient (3,3,n), unused
+    real(wp), intent(in) :: strain(:,:)    !! strain (6,n), unused
+    real(wp), intent(in) :: stress(:,:)    !! stress (6,n), unused
+    real(wp), intent(in) :: state(:,:)     !! state variables, row nstatv+1 is SSE
+    real(wp), intent(out) :: psi(:)        !! SSE (n) [J/m³]
+    integer :: p
+    associate (unused_ => F, unused2_ => strain, unused3_ => stress); end associate
+    do p = 1, min(size(psi), size(state, 2))
+      psi(p) = state(self%nstatv + 1, p)
+    end do
+  end subroutine um_energy_density
+
+  !> Why the UMAT adapter stopped a particle.
+  function um_failure_text(self) result(s)
+    class(empm_umat_t), intent(in) :: self !! material
+    character(len=:), allocatable :: s     !! reason
+    character(len=12) :: buf
+    integer :: why
+    why = 0
+    if (associated(self%why)) why = self%why
+    select case (why)
+    case (WHY_NONFINITE)
+      s = 'the UMAT returned a non-finite stress'
+    case (WHY_NSTATV)
+      write(buf, '(i0)') self%nstatv
+      s = 'the UMAT wrote past STATEV(NSTATV) with NSTATV = '//trim(buf)// &
+        ': nstatv in the case file is smaller than the number of state variables the UMAT uses'
+    case (WHY_PNEWDT)
+      write(buf, '(i0)') UMAT_MAX_SUB
+      s = 'the UMAT asked for a smaller increment (PNEWDT < 1) even with the step cut into ' &
+        //trim(buf)//' sub-increments'
+    case default
+      s = 'its volume ratio became <= 0 (e.g. det F <= 0: the particle is inverted)'
+    end select
+  end function um_failure_text
+end module empm_material_umat

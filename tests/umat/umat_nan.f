@@ -1,0 +1,34 @@
+C     A UMAT that returns a NaN stress from the second increment on
+C     (elastic before that), for the empm adapter's non-finite guard.
+C     The NaN is set bit for bit (no arithmetic: the test program may
+C     trap floating-point exceptions). PROPS(1) = E, PROPS(2) = NU.
+      SUBROUTINE UMAT(STRESS,STATEV,DDSDDE,SSE,SPD,SCD,
+     1 RPL,DDSDDT,DRPLDE,DRPLDT,
+     2 STRAN,DSTRAN,TIME,DTIME,TEMP,DTEMP,PREDEF,DPRED,CMNAME,
+     3 NDI,NSHR,NTENS,NSTATV,PROPS,NPROPS,COORDS,DROT,PNEWDT,
+     4 CELENT,DFGRD0,DFGRD1,NOEL,NPT,LAYER,KSPT,KSTEP,KINC)
+      IMPLICIT DOUBLE PRECISION (A-H,O-Z)
+      CHARACTER*80 CMNAME
+      DIMENSION STRESS(NTENS),STATEV(NSTATV),
+     1 DDSDDE(NTENS,NTENS),DDSDDT(NTENS),DRPLDE(NTENS),
+     2 STRAN(NTENS),DSTRAN(NTENS),TIME(2),PREDEF(1),DPRED(1),
+     3 PROPS(NPROPS),COORDS(3),DROT(3,3),DFGRD0(3,3),DFGRD1(3,3)
+      INTEGER*8 INAN
+      DOUBLE PRECISION DNAN
+      EQUIVALENCE (INAN, DNAN)
+      DATA INAN /Z'7FF8000000000000'/
+C
+      E = PROPS(1)
+      ANU = PROPS(2)
+      ALAMB = E*ANU/((1.D0+ANU)*(1.D0-2.D0*ANU))
+      AMU = E/(2.D0*(1.D0+ANU))
+      TR = DSTRAN(1) + DSTRAN(2) + DSTRAN(3)
+      DO 10 I = 1, NDI
+        STRESS(I) = STRESS(I) + ALAMB*TR + 2.D0*AMU*DSTRAN(I)
+   10 CONTINUE
+      DO 20 I = NDI+1, NTENS
+        STRESS(I) = STRESS(I) + AMU*DSTRAN(I)
+   20 CONTINUE
+      IF (KINC .GE. 2) STRESS(1) = DNAN
+      RETURN
+      END

@@ -1,0 +1,46 @@
+C     A UMAT that records what it receives, for the adapter's unit test
+C     (tests/unit/test_umat.pf): it leaves STRESS as received and writes
+C       STATEV(1:NTENS)   DSTRAN        STATEV(7:15)  DROT (by columns)
+C       STATEV(16)        NOEL          STATEV(17)    KINC
+C       STATEV(18)        CELENT        STATEV(19:27) DFGRD1
+C       STATEV(28:30)     NTENS, NDI, NSHR
+C       STATEV(31:32)     TIME(1), DTIME
+C       STATEV(33:32+NTENS) STRESS as received
+C       STATEV(39:40)     NPROPS, PROPS(1)
+C       STATEV(41:40+NTENS) STRAN as received
+C     NSTATV must be at least 46.
+      SUBROUTINE UMAT(STRESS,STATEV,DDSDDE,SSE,SPD,SCD,
+     1 RPL,DDSDDT,DRPLDE,DRPLDT,
+     2 STRAN,DSTRAN,TIME,DTIME,TEMP,DTEMP,PREDEF,DPRED,CMNAME,
+     3 NDI,NSHR,NTENS,NSTATV,PROPS,NPROPS,COORDS,DROT,PNEWDT,
+     4 CELENT,DFGRD0,DFGRD1,NOEL,NPT,LAYER,KSPT,KSTEP,KINC)
+      IMPLICIT DOUBLE PRECISION (A-H,O-Z)
+      CHARACTER*80 CMNAME
+      DIMENSION STRESS(NTENS),STATEV(NSTATV),
+     1 DDSDDE(NTENS,NTENS),DDSDDT(NTENS),DRPLDE(NTENS),
+     2 STRAN(NTENS),DSTRAN(NTENS),TIME(2),PREDEF(1),DPRED(1),
+     3 PROPS(NPROPS),COORDS(3),DROT(3,3),DFGRD0(3,3),DFGRD1(3,3)
+C
+      DO 10 I = 1, NTENS
+        STATEV(I) = DSTRAN(I)
+        STATEV(32+I) = STRESS(I)
+        STATEV(40+I) = STRAN(I)
+   10 CONTINUE
+      DO 30 J = 1, 3
+        DO 20 I = 1, 3
+          STATEV(6+I+3*(J-1)) = DROT(I,J)
+          STATEV(18+I+3*(J-1)) = DFGRD1(I,J)
+   20   CONTINUE
+   30 CONTINUE
+      STATEV(16) = NOEL
+      STATEV(17) = KINC
+      STATEV(18) = CELENT
+      STATEV(28) = NTENS
+      STATEV(29) = NDI
+      STATEV(30) = NSHR
+      STATEV(31) = TIME(1)
+      STATEV(32) = DTIME
+      STATEV(39) = NPROPS
+      STATEV(40) = PROPS(1)
+      RETURN
+      END
