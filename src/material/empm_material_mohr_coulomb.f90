@@ -102,6 +102,17 @@ module empm_material_mohr_coulomb
     real(wp) :: spsi = 0.0_wp         !! sin ψ (cached)
     real(wp) :: m(3, NPLANE) = 0.0_wp !! flow directions of the planes (principal)
     real(wp) :: r(3, NPLANE) = 0.0_wp !! D m of the planes
+    ! Constants of the fixed-strength return (no softening), see [[mc_prepare]].
+    logical :: fixed = .false.        !! strength fixed: the closed-form return applies
+    real(wp) :: k0 = 0.0_wp           !! 2c cos φ [Pa]
+    real(wp) :: st0 = 0.0_wp          !! cut-off value (huge without one) [Pa]
+    real(wp) :: ap = 0.0_wp           !! 1 + sin φ (major coefficient of the MC planes)
+    real(wp) :: am = 0.0_wp           !! 1 − sin φ (minor coefficient)
+    real(wp) :: inv_plane = 0.0_wp    !! 1/(a·D m) of the main plane [1/Pa]
+    real(wp) :: inv_comp(2,2) = 0.0_wp  !! inverse of [a_i·D m_j] of the compression edge
+    real(wp) :: inv_ext(2,2) = 0.0_wp   !! inverse of [a_i·D m_j] of the extension edge
+    real(wp) :: kap_plane = 0.0_wp    !! sqrt(2/3)|dev m| of the main plane
+    real(wp) :: dev_m(3, 3) = 0.0_wp  !! sqrt(2/3) dev m of the three MC planes
   contains
     procedure :: configure => mc_configure
     procedure :: family => mc_family
@@ -262,7 +273,57 @@ contains
       end if
       self%r(:, j) = self%lam * sum(self%m(:, j)) + 2.0_wp * self%G * self%m(:, j)
     end do
+    call mc_prepare(self)
   end subroutine mc_configure
+
+  !> Constants of the closed-form return at fixed strength (no softening): with fixed planes
+  !> the products a_i·D m_j of the main plane and of the two edges are constants, so their
+  !> multipliers are a product with a precomputed inverse (no elimination per particle).
+  pure subroutine mc_prepare(self)
+    class(empm_mohr_coulomb_t), intent(inout) :: self !! material, configured
+    real(wp) :: A(2,2), det, dm(3)
+    integer :: j
+    self%fixed = self%eps_soft <= 0.0_wp
+    self%k0 = 2.0_wp * self%c0 * self%cphi
+    self%st0 = huge(1.0_wp)
+    if (self%cutoff) then
+      if (self%cutoff_apex) then
+        self%st0 = self%c0 * self%cphi / self%sphi
+      else
+        self%st0 = self%st_user
+      end if
+    end if
+    self%ap = 1.0_wp + self%sphi; self%am = 1.0_wp - self%sphi
+    do j = 1, 3
+      dm = self%m(:, j) - sum(self%m(:, j)) / 3.0_wp
+      self%dev_m(:, j) = sqrt(2.0_wp / 3.0_wp) * dm
+    end do
+    self%kap_plane = sqrt(sum(self%dev_m(:, 1)**2))
+    ! Planes 1 (F13) and 2 (F23) meet on σ1 = σ2, planes 1 and 3 (F12) on σ2 = σ3.
+    self%inv_plane = 1.0_wp / dot_product(grad(1), self%r(:, 1))
+    A = reshape([dot_product(grad(1), self%r(:, 1)), dot_product(grad(2), self%r(:, 1)), &
+                 dot_product(grad(1), self%r(:, 2)), dot_product(grad(2), self%r(:, 2))], [2, 2])
+    det = A(1,1) * A(2,2) - A(1,2) * A(2,1)
+    if (.not. abs(det) > 0.0_wp) then
+      self%fixed = .false.; return
+    end if
+    self%inv_comp = reshape([A(2,2), -A(2,1), -A(1,2), A(1,1)], [2, 2]) / det
+    A = reshape([dot_product(grad(1), self%r(:, 1)), dot_product(grad(3), self%r(:, 1)), &
+                 dot_product(grad(1), self%r(:, 3)), dot_product(grad(3), self%r(:, 3))], [2, 2])
+    det = A(1,1) * A(2,2) - A(1,2) * A(2,1)
+    if (.not. abs(det) > 0.0_wp) then
+      self%fixed = .false.; return
+    end if
+    self%inv_ext = reshape([A(2,2), -A(2,1), -A(1,2), A(1,1)], [2, 2]) / det
+  contains
+    ! Gradient of MC plane j at the peak strength.
+    pure function grad(j) result(a)
+      integer, intent(in) :: j
+      real(wp) :: a(3)
+      a = 0.0_wp
+      a(MAJ(j)) = 1.0_wp + self%sphi; a(MIN_(j)) = -(1.0_wp - self%sphi)
+    end function grad
+  end subroutine mc_prepare
 
   ! ---- strength and the principal-space return ---------------------------------------------
 
@@ -316,7 +377,7 @@ contains
     real(wp), intent(in) :: sig(3)                 !! principal stresses, decreasing [Pa]
     real(wp), intent(in) :: kappa                  !! eps_p_shear
     real(wp) :: s, cs, k, st, ds, dk, dst
-    call self%strength(kappa, s, cs, k, st, ds, dk, dst)
+    call mc_strength(self, kappa, s, cs, k, st, ds, dk, dst)
     f = (sig(1) - sig(3)) + (sig(1) + sig(3)) * s - k
     if (self%cutoff) f = max(f, sig(1) - st)
   end function mc_yield_value
@@ -324,8 +385,10 @@ contains
   !> Return of an ordered trial `str` (σ1 ≥ σ2 ≥ σ3) in principal space: the stress `sig`,
   !> the increments of eps_p_shear and eps_p_vol and the region. `info` = 0, or 1 when no
   !> region passed or the softening iteration did not converge (region MC_NO_REGION or
-  !> MC_NO_CONVERGENCE; `sig` is then the trial).
-  pure subroutine mc_return_map(self, str, kappa, sig, dkappa, devol, region, info)
+  !> MC_NO_CONVERGENCE; `sig` is then the trial). At fixed strength the closed-form return
+  !> ([[fixed_return]]) decides first; `general` = .true. forces the candidate-set search
+  !> (the reference the unit test compares it with).
+  pure subroutine mc_return_map(self, str, kappa, sig, dkappa, devol, region, info, general)
     class(empm_mohr_coulomb_t), intent(in) :: self !! material
     real(wp), intent(in) :: str(3)                 !! trial principal stresses [Pa]
     real(wp), intent(in) :: kappa                  !! eps_p_shear at the start
@@ -334,13 +397,20 @@ contains
     real(wp), intent(out) :: devol                 !! increment of eps_p_vol
     integer, intent(out) :: region                 !! MC_* region
     integer, intent(out) :: info                   !! 0 ok, 1 failed
+    logical, intent(in), optional :: general       !! skip the closed-form return
     real(wp) :: scale, lam(3), s, cs, k, st, ds, dk, dst, ep(3)
     integer :: ic, i, j, l, nap, ap(9), set(3)
-    logical :: ok, conv
+    logical :: ok, conv, done
     sig = str; dkappa = 0.0_wp; devol = 0.0_wp; info = 0
     region = MC_ELASTIC
-    if (self%yield_value(str, kappa) <= 0.0_wp) return
-    call self%strength(kappa, s, cs, k, st, ds, dk, dst)
+    done = .false.
+    if (present(general)) done = general
+    if (self%fixed .and. .not. done) then
+      call fixed_return(self, str, sig, dkappa, devol, region, done)
+      if (done) return
+    end if
+    if (mc_yield_value(self, str, kappa) <= 0.0_wp) return
+    call mc_strength(self, kappa, s, cs, k, st, ds, dk, dst)
     scale = max(maxval(abs(str)) + self%c0, 1.0e-200_wp)
     do ic = 1, NCAND
       if (.not. self%cutoff .and. any(CAND(1:CAND_N(ic), ic) >= 4)) cycle
@@ -417,7 +487,7 @@ contains
         do it = 1, NEWTON_MAX
           call state_of(n, set, lam, sig, ep, dev, dkappa)
           kap = kappa + dkappa
-          call self%strength(kap, s1, cs1, k1, st1, ds1, dk1, dst1)
+          call mc_strength(self, kap, s1, cs1, k1, st1, ds1, dk1, dst1)
           ! d(dkappa)/dλ_j; at dkappa = 0 the one-sided value.
           do jj = 1, n
             sm = sum(self%m(:, set(jj))) / 3.0_wp
@@ -450,7 +520,7 @@ contains
       devol = sum(ep)
       if (any(lam(1:n) < -REL_TOL * scale / self%G)) return
       if (sig(1) - sig(2) < -REL_TOL * scale .or. sig(2) - sig(3) < -REL_TOL * scale) return
-      if (self%yield_value(sig, kappa + dkappa) > REL_TOL * scale) return
+      if (mc_yield_value(self, sig, kappa + dkappa) > REL_TOL * scale) return
       ok = .true.
     end subroutine try_set
 
@@ -493,6 +563,87 @@ contains
     end subroutine state_of
   end subroutine mc_return_map
 
+  !> The return at fixed strength, decided from the trial directly: the main plane when its
+  !> closed-form stress σ* − Δλ D m (Δλ = f*/(a·D m)) keeps the order σ1 ≥ σ2 ≥ σ3 and the
+  !> cut-off; else the compression edge, else the extension edge (2×2 multipliers from the
+  !> precomputed inverses), accepted under the same tests as in [[mc_return_map]]; else,
+  !> with the cut-off at the apex, the apex. `done` false leaves the trial to the candidate-set
+  !> search: a given cut-off below the apex that the trial exceeds, or a trial beyond both
+  !> edges without the apex cut-off (rare; the search then repeats these three sets).
+  pure subroutine fixed_return(self, str, sig, dkappa, devol, region, done)
+    class(empm_mohr_coulomb_t), intent(in) :: self !! material (fixed strength)
+    real(wp), intent(in) :: str(3)                 !! trial principal stresses, ordered [Pa]
+    real(wp), intent(out) :: sig(3)                !! returned principal stresses [Pa]
+    real(wp), intent(out) :: dkappa                !! increment of eps_p_shear
+    real(wp), intent(out) :: devol                 !! increment of eps_p_vol
+    integer, intent(out) :: region                 !! MC_* region
+    logical, intent(out) :: done                   !! false: not decided here
+    real(wp) :: f1, f2, f3, ft, tol, ltol, l1, l2, ep(3)
+    sig = str; dkappa = 0.0_wp; devol = 0.0_wp; region = MC_ELASTIC; done = .true.
+    f1 = self%ap * str(1) - self%am * str(3) - self%k0
+    ft = str(1) - self%st0
+    if (f1 <= 0.0_wp .and. ft <= 0.0_wp) return
+    if (ft > 0.0_wp .and. .not. self%cutoff_apex) then
+      done = .false.; return
+    end if
+    tol = REL_TOL * max(max(abs(str(1)), abs(str(3))) + self%c0, 1.0e-200_wp)
+    ltol = -tol / self%G
+    ! Main plane.
+    l1 = f1 * self%inv_plane
+    sig = str - l1 * self%r(:, 1)
+    if (l1 >= ltol .and. admissible(sig)) then
+      dkappa = l1 * self%kap_plane
+      devol = l1 * (self%m(1, 1) + self%m(3, 1))
+      region = MC_PLANE; return
+    end if
+    ! Compression edge σ1 = σ2 (planes F13, F23).
+    f2 = self%ap * str(2) - self%am * str(3) - self%k0
+    l1 = self%inv_comp(1,1) * f1 + self%inv_comp(1,2) * f2
+    l2 = self%inv_comp(2,1) * f1 + self%inv_comp(2,2) * f2
+    sig = str - l1 * self%r(:, 1) - l2 * self%r(:, 2)
+    if (l1 >= ltol .and. l2 >= ltol .and. admissible(sig)) then
+      call plastic(l1, l2, 2, dkappa, devol)
+      region = MC_EDGE_COMPRESSION; return
+    end if
+    ! Extension edge σ2 = σ3 (planes F13, F12).
+    f3 = self%ap * str(1) - self%am * str(2) - self%k0
+    l1 = self%inv_ext(1,1) * f1 + self%inv_ext(1,2) * f3
+    l2 = self%inv_ext(2,1) * f1 + self%inv_ext(2,2) * f3
+    sig = str - l1 * self%r(:, 1) - l2 * self%r(:, 3)
+    if (l1 >= ltol .and. l2 >= ltol .and. admissible(sig)) then
+      call plastic(l1, l2, 3, dkappa, devol)
+      region = MC_EDGE_EXTENSION; return
+    end if
+    if (.not. self%cutoff_apex) then
+      sig = str; done = .false.; return
+    end if
+    ! The apex (see mc_return_map): the plastic strain is D⁻¹(σ* − σ).
+    sig = self%st0
+    ep = (str - sig) / (2.0_wp * self%G)
+    ep = ep - self%lam / (2.0_wp * self%G) * sum(str - sig) / (3.0_wp * self%K)
+    devol = sum(ep)
+    dkappa = sqrt(2.0_wp / 3.0_wp * sum((ep - devol / 3.0_wp)**2))
+    region = MC_APEX
+
+  contains
+
+    ! Ordered and inside the main plane and the cut-off, to the acceptance tolerance.
+    pure logical function admissible(x)
+      real(wp), intent(in) :: x(3)
+      admissible = x(1) - x(2) >= -tol .and. x(2) - x(3) >= -tol .and. &
+        self%ap * x(1) - self%am * x(3) - self%k0 <= tol .and. x(1) - self%st0 <= tol
+    end function admissible
+
+    ! Plastic strain increments of the main plane and plane j with multipliers a, b.
+    pure subroutine plastic(a, b, j, dkap, dvol)
+      real(wp), intent(in) :: a, b
+      integer, intent(in) :: j
+      real(wp), intent(out) :: dkap, dvol
+      dkap = sqrt(sum((a * self%dev_m(:, 1) + b * self%dev_m(:, j))**2))
+      dvol = a * sum(self%m(:, 1)) + b * sum(self%m(:, j))
+    end subroutine plastic
+  end subroutine fixed_return
+
   !> Gaussian elimination with partial pivoting for n ≤ 3; ok false when singular.
   pure subroutine solve_small(n, A, b, x, ok)
     integer, intent(in) :: n
@@ -528,24 +679,80 @@ contains
 
   ! ---- one stress point ----------------------------------------------------------------------
 
-  !> One return over the strain increment `de` from the (rotated) stress `s`.
+  !> One return over the strain increment `de` from the (rotated) stress `s`. With yz = xz = 0
+  !> (1D, plane strain) zz is principal and the in-plane pair is c ± r, r = |((xx − yy)/2, xy)|:
+  !> an elastic trial needs no directions at all, and the returned in-plane pair c' ± r' goes
+  !> back by scaling the trial's in-plane deviator by r'/r (coaxiality), without forming Q.
   pure subroutine one_return(self, s, de, kappa, evol, region, info)
     class(empm_mohr_coulomb_t), intent(in) :: self
     real(wp), intent(inout) :: s(6), kappa, evol
     real(wp), intent(in) :: de(6)
     integer, intent(out) :: region, info
-    real(wp) :: tr, p(3), Q(3,3), pn(3), dk, dv
+    real(wp) :: tr, p(3), Q(3,3), pn(3), dk, dv, c, d, r, pa, pb, pz, t
+    integer :: iz
     tr = de(1) + de(2) + de(3)
     s(1:3) = s(1:3) + self%lam * tr + 2.0_wp * self%G * de(1:3)
     s(4:6) = s(4:6) + 2.0_wp * self%G * de(4:6)
-    call principal_decompose(s, p, Q)
     region = MC_ELASTIC; info = 0
-    if (self%yield_value(p, kappa) <= 0.0_wp) return
-    call self%return_map(p, kappa, pn, dk, dv, region, info)
-    if (info /= 0) return
-    s = principal_compose(pn, Q)
+    if (s(4) == 0.0_wp .and. s(5) == 0.0_wp) then
+      c = 0.5_wp * (s(1) + s(2))
+      d = 0.5_wp * (s(1) - s(2))
+      ! hypot only where the squares could overflow (it is a slow library call).
+      if (max(abs(d), abs(s(6))) < 1.0e150_wp) then
+        r = sqrt(d * d + s(6) * s(6))
+      else
+        r = hypot(d, s(6))
+      end if
+      ! The order of principal_decompose: zz after any equal in-plane value.
+      if (s(3) > c + r) then
+        iz = 1; p = [s(3), c + r, c - r]
+      else if (s(3) > c - r) then
+        iz = 2; p = [c + r, s(3), c - r]
+      else
+        iz = 3; p = [c + r, c - r, s(3)]
+      end if
+      if (.not. plastic_trial(p)) return
+      call mc_return_map(self, p, kappa, pn, dk, dv, region, info)
+      if (info /= 0) return
+      select case (iz)
+      case (1)
+        pz = pn(1); pa = pn(2); pb = pn(3)
+      case (2)
+        pa = pn(1); pz = pn(2); pb = pn(3)
+      case default
+        pa = pn(1); pb = pn(2); pz = pn(3)
+      end select
+      if (r > 0.0_wp) then
+        t = 0.5_wp * (pa - pb) / r
+        s(1) = 0.5_wp * (pa + pb) + t * d
+        s(2) = 0.5_wp * (pa + pb) - t * d
+        s(6) = t * s(6)
+      else
+        s(1) = pa; s(2) = pb; s(6) = 0.0_wp
+      end if
+      s(3) = pz
+    else
+      call principal_decompose(s, p, Q)
+      if (.not. plastic_trial(p)) return
+      call mc_return_map(self, p, kappa, pn, dk, dv, region, info)
+      if (info /= 0) return
+      s = principal_compose(pn, Q)
+    end if
     kappa = kappa + dk
     evol = evol + dv
+
+  contains
+
+    ! The trial violates the yield condition (fixed strength: the precomputed planes).
+    pure logical function plastic_trial(x)
+      real(wp), intent(in) :: x(3)
+      if (self%fixed) then
+        plastic_trial = self%ap * x(1) - self%am * x(3) - self%k0 > 0.0_wp &
+          .or. x(1) - self%st0 > 0.0_wp
+      else
+        plastic_trial = mc_yield_value(self, x, kappa) > 0.0_wp
+      end if
+    end function plastic_trial
   end subroutine one_return
 
   !> Stress update of one point over the strain increment `de` from the (already rotated)
@@ -576,13 +783,13 @@ contains
     dp(4:6) = 2.0_wp * self%G * de(4:6)
     call principal_decompose(s, p, Q)
     a = 0.0_wp
-    if (self%yield_value(p, kappa) < 0.0_wp) then
+    if (mc_yield_value(self, p, kappa) < 0.0_wp) then
       lo = 0.0_wp; hi = 1.0_wp
       do it = 1, 52
         mid = 0.5_wp * (lo + hi)
         se = s + mid * dp
         call principal_decompose(se, p, Q)
-        if (self%yield_value(p, kappa) < 0.0_wp) then
+        if (mc_yield_value(self, p, kappa) < 0.0_wp) then
           lo = mid
         else
           hi = mid
@@ -661,7 +868,7 @@ contains
       end if
       strain(:,p) = strain(:,p) + de
       call jaumann_rotate(dt, L(:,:,p), stress(:,p))
-      call self%integrate(stress(:,p), de, state(1,p), state(2,p), region, ip)
+      call mc_integrate(self, stress(:,p), de, state(1,p), state(2,p), region, ip)
       if (ip /= 0 .and. info == 0) info = p
       rho(p) = rho(p) / (1.0_wp + tr)
     end do

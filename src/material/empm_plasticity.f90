@@ -37,13 +37,26 @@ contains
     real(wp), intent(in) :: dt       !! time step [s]
     real(wp), intent(in) :: L(3,3)   !! velocity gradient [1/s]
     real(wp), intent(inout) :: s(6)  !! Cauchy stress, Voigt [Pa]
-    real(wp) :: a(3), c, Q(3,3), S3(3,3), T(3,3)
+    real(wp) :: a(3), c, Q(3,3), S3(3,3), T(3,3), ct, st, t11, t22, t12, t13
     integer :: i, j
     ! Axial vector of A = ½ΔtW: A x = a × x.
     a(1) = 0.25_wp * dt * (L(3,2) - L(2,3))
     a(2) = 0.25_wp * dt * (L(1,3) - L(3,1))
     a(3) = 0.25_wp * dt * (L(2,1) - L(1,2))
-    if (a(1) == 0.0_wp .and. a(2) == 0.0_wp .and. a(3) == 0.0_wp) return
+    if (a(1) == 0.0_wp .and. a(2) == 0.0_wp) then
+      if (a(3) == 0.0_wp) return
+      ! Spin about z alone (every 2D step): Q is the in-plane rotation cos = 1 − c a3²,
+      ! sin = c a3 (the same Q as below, written out: a quarter of the 3×3 products).
+      c = 2.0_wp / (1.0_wp + a(3)**2)
+      ct = 1.0_wp - c * a(3)**2; st = c * a(3)
+      t11 = ct * ct * s(1) - 2.0_wp * ct * st * s(6) + st * st * s(2)
+      t22 = st * st * s(1) + 2.0_wp * ct * st * s(6) + ct * ct * s(2)
+      t12 = ct * st * (s(1) - s(2)) + (ct * ct - st * st) * s(6)
+      t13 = ct * s(5) - st * s(4)
+      s(4) = st * s(5) + ct * s(4)
+      s(1) = t11; s(2) = t22; s(5) = t13; s(6) = t12
+      return
+    end if
     ! Q = I + 2/(1 + a·a) (A + A²), with A² = a aᵀ − (a·a) I.
     c = 2.0_wp / (1.0_wp + a(1)**2 + a(2)**2 + a(3)**2)
     do j = 1, 3
