@@ -14,6 +14,7 @@ program empm_main
   integer :: nargs, i, ios, nfail, npat, nthreads
   character(len=:), allocatable :: cmd, case_file, out_file, written, manifest, outdir
   character(len=256), allocatable :: patterns(:)
+  character(len=64) :: numtext
   logical :: quick
   type(empm_error_t) :: err
   type(empm_bench_config_t) :: bcfg
@@ -114,6 +115,11 @@ program empm_main
       case ('--integrator'); bcfg%integrator = arg(i + 1)
       case ('--material');   bcfg%material = arg(i + 1)
       case ('--material-keys'); bcfg%material_keys = arg(i + 1)
+      case ('--confinement')
+        numtext = arg(i + 1)
+        read(numtext, *, iostat=ios) bcfg%confinement
+        if (ios /= 0 .or. bcfg%confinement < 0) &
+          call die('--confinement needs a pressure >= 0 [Pa]')
       case default;          call die('unknown option '//arg(i))
       end select
       i = i + 2
@@ -205,6 +211,7 @@ contains
     write(u, '(a)') 'usage: empm bench [--dim 2|3] [--shape S] [--cells N] [--ppc P] [--steps K]'
     write(u, '(a)') '                  [--threads T] [--integrator I] [--warmup W]'
     write(u, '(a)') '                  [--material M] [--material-keys ''k = v, ...'']'
+    write(u, '(a)') '                  [--confinement P0]'
     write(u, '(a)') ''
     write(u, '(a)') 'Times a freely vibrating block (N^dim cells, P particles per cell) and'
     write(u, '(a)') 'prints one JSON object (docs/performance.md). S is a shape identifier as in a'
@@ -212,10 +219,13 @@ contains
     write(u, '(a)') 'integrator (usf, usl, musl, pc_published, pc_newmark, gen_alpha); K timed'
     write(u, '(a)') 'steps after W warm-up steps on T threads. M is a material model (empm keys;'
     write(u, '(a)') 'default linear_elastic) with E = 1e7 Pa, nu = 0.3, density = 1000 kg/m3 and'
-    write(u, '(a)') 'bench defaults that make soil models yield (mohr_coulomb: cohesion = 500,'
-    write(u, '(a)') 'friction_angle = 30, dilatancy_angle = 5); --material-keys replaces keys of'
-    write(u, '(a)') 'the same name and adds others. "plastic_fraction" in the output is the share'
-    write(u, '(a)') 'of particle updates that changed a state variable.'
+    write(u, '(a)') 'bench defaults that make soil models yield (mohr_coulomb, drucker_prager:'
+    write(u, '(a)') 'cohesion = 500, friction_angle = 30, dilatancy_angle = 5; camclay: lambda ='
+    write(u, '(a)') '0.2, kappa = 0.04, M = 1.2, e0 = 1, ocr = 1); --material-keys replaces keys of'
+    write(u, '(a)') 'the same name and adds others. The block starts under an isotropic pressure'
+    write(u, '(a)') 'P0 [Pa] (default: 1e4 for camclay, 0 otherwise). A umat library path is'
+    write(u, '(a)') 'relative to the working folder. "plastic_fraction" in the output is the'
+    write(u, '(a)') 'share of particle updates that changed a state variable.'
   end subroutine usage_bench
 
   subroutine usage_keys(u)

@@ -28,7 +28,6 @@
 module empm_material_umat
   use, intrinsic :: iso_c_binding, only: c_ptr, c_funptr, c_double, c_int, c_char, c_size_t, &
     c_f_procpointer, c_null_ptr, c_null_funptr, c_associated
-  use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t
@@ -111,6 +110,8 @@ module empm_material_umat
     real(wp), allocatable :: props(:)          !! PROPS
     integer :: nstatv = 0                      !! NSTATV
     logical :: thread_safe = .false.           !! the UMAT may run concurrently
+    logical :: uses_stran = .true.             !! keep STRAN rotated with the material
+    logical :: uses_dfgrd = .true.             !! advance F for DFGRD1
     real(wp) :: lambda = 0.0_wp                !! Lamé λ for the CFL bound [Pa]
     real(wp) :: mu = 0.0_wp                    !! shear modulus for the CFL bound [Pa]
     type(c_ptr) :: handle = c_null_ptr         !! loaded library (kept open for the run)
@@ -150,7 +151,7 @@ contains
   end function um_summary
 
   !> Parameters: `library`, `symbol`, `props`, `nstatv`, `density`, `E`, `nu`, `wave_modulus`,
-  !> `thread_safe`.
+  !> `thread_safe`, `uses_stran`, `uses_dfgrd`.
   pure function um_params(self) result(p)
     class(empm_umat_t), intent(in) :: self !! material
     type(empm_param_t), allocatable :: p(:) !! declarations
@@ -176,7 +177,14 @@ contains
         lo=0.0_wp, lo_open=.true., hi=1.0e30_wp, optional=.true.), &
       empm_param('thread_safe', PARAM_LOGICAL, '-', 'the UMAT may be called concurrently ' &
         //'(no SAVEd or COMMON data); when false the calls are serialised', &
-        default='.false.')]
+        default='.false.'), &
+      empm_param('uses_stran', PARAM_LOGICAL, '-', 'the UMAT reads STRAN: the total strain ' &
+        //'is rotated with the stress every step (false: it is accumulated unrotated, as the ' &
+        //'native models store it, and passed as such; saves a rotation per particle)', &
+        default='.true.'), &
+      empm_param('uses_dfgrd', PARAM_LOGICAL, '-', 'the UMAT reads DFGRD0/DFGRD1: F is ' &
+        //'advanced every step (false: F is left unchanged, as by the native rate-form ' &
+        //'models, and passed as both)', default='.true.')]
   end function um_params
 
   !> Read the keys, load the library and look the symbol up.
@@ -203,6 +211,8 @@ contains
     call group%get(p(7), nu, err)
     call group%get(p(8), m, err)
     call group%get(p(9), self%thread_safe, err)
+    call group%get(p(10), self%uses_stran, err)
+    call group%get(p(11), self%uses_dfgrd, err)
     if (err%code /= 0) return
     self%props = props(1:nprops)
     ! The stiffness bound for the CFL step: exactly one of E (with nu) and wave_modulus.
@@ -414,19 +424,25 @@ contains
         dsub = strain_increment(h, Lp)
       end if
       s = sp; e = ep; F0 = Fp
-      statev(1:nsv) = stp(1:nsv)
+      do i = 1, nsv
+        statev(i) = stp(i)
+      end do
       sse = stp(nsv + 1); spd = stp(nsv + 2); scd = stp(nsv + 3)
       why = 0; pnewdt = 1.0_wp
       call step_rotation(h, Lp, drot, spin)
       do j = 1, k
         if (spin) then
-          call rotate(drot, s)
-          call rotate(drot, e)
+          call rotate(ntens, drot, s)
+          if (self%uses_stran) call rotate(ntens, drot, e)
         end if
-        call advance(h, Lp, F0, F1)
-        call to_abaqus(s, 1.0_wp, sig)
-        call to_abaqus(e, 2.0_wp, stran)
-        call to_abaqus(dsub, 2.0_wp, dstran)
+        if (self%uses_dfgrd) then
+          call advance(ntens, h, Lp, F0, F1)
+        else
+          F1 = F0
+        end if
+        call to_abaqus(ntens, s, 1.0_wp, sig)
+        call to_abaqus(ntens, e, 2.0_wp, stran)
+        call to_abaqus(ntens, dsub, 2.0_wp, dstran)
         time = ctx%t + (j - 1) * h
         dtime = h
         pnewdt = 1.0e36_wp ! "no limit": a UMAT lowers it to ask for a smaller increment
@@ -440,128 +456,142 @@ contains
           end if
         end do
         do i = 1, ntens
-          if (.not. ieee_is_finite(sig(i))) then
+          if (.not. finite(sig(i))) then
             why = WHY_NONFINITE; return
           end if
         end do
         if (pnewdt < 1.0_wp) then
           why = WHY_PNEWDT; return
         end if
-        call from_abaqus(sig, s)
+        call from_abaqus(ntens, sig, s)
         e = e + dsub
         F0 = F1
       end do
       sp = s; ep = e; Fp = F0
-      stp(1:nsv) = statev(1:nsv)
+      do i = 1, nsv
+        stp(i) = statev(i)
+      end do
       stp(nsv + 1) = sse; stp(nsv + 2) = spd; stp(nsv + 3) = scd
     end subroutine increments
-
-    ! The step's rotation Q = (I − ½ΔtW)⁻¹(I + ½ΔtW), W = skew(L), with the formula (and the
-    ! operations) of jaumann_rotate in empm_plasticity, which the native rate-form models use:
-    ! the UMAT's stress is rotated exactly as theirs. spin = false when W = 0 (Q = I).
-    pure subroutine step_rotation(dt, L, Q, spin)
-      real(wp), intent(in) :: dt, L(3,3)
-      real(wp), intent(out) :: Q(3,3)
-      logical, intent(out) :: spin
-      real(wp) :: a(3), c
-      integer :: i, j
-      a(1) = 0.25_wp * dt * (L(3,2) - L(2,3))
-      a(2) = 0.25_wp * dt * (L(1,3) - L(3,1))
-      a(3) = 0.25_wp * dt * (L(2,1) - L(1,2))
-      Q = 0.0_wp
-      Q(1,1) = 1.0_wp; Q(2,2) = 1.0_wp; Q(3,3) = 1.0_wp
-      spin = .not. (a(1) == 0.0_wp .and. a(2) == 0.0_wp .and. a(3) == 0.0_wp)
-      if (.not. spin) return
-      c = 2.0_wp / (1.0_wp + a(1)**2 + a(2)**2 + a(3)**2)
-      do j = 1, 3
-        do i = 1, 3
-          Q(i,j) = c * a(i) * a(j)
-        end do
-      end do
-      Q(1,1) = Q(1,1) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
-      Q(2,2) = Q(2,2) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
-      Q(3,3) = Q(3,3) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
-      Q(1,2) = Q(1,2) - c * a(3); Q(2,1) = Q(2,1) + c * a(3)
-      Q(1,3) = Q(1,3) + c * a(2); Q(3,1) = Q(3,1) - c * a(2)
-      Q(2,3) = Q(2,3) - c * a(1); Q(3,2) = Q(3,2) + c * a(1)
-    end subroutine step_rotation
-
-    ! t ← Q t Qᵀ for a symmetric tensor in Voigt form (tensor shears), as jaumann_rotate does
-    ! (Q (t Qᵀ), then the symmetric part). In plane strain (ntens = 4) Q and t have no 13, 23
-    ! entries: the terms dropped are exact zeros, so the sums are the same.
-    pure subroutine rotate(Q, t)
-      real(wp), intent(in) :: Q(3,3)
-      real(wp), intent(inout) :: t(6)
-      real(wp) :: T3(3,3), R(3,3), M(3,3)
-      if (ntens == 4) then
-        M(1,1) = t(1) * Q(1,1) + t(6) * Q(1,2)
-        M(1,2) = t(1) * Q(2,1) + t(6) * Q(2,2)
-        M(2,1) = t(6) * Q(1,1) + t(2) * Q(1,2)
-        M(2,2) = t(6) * Q(2,1) + t(2) * Q(2,2)
-        R(1,1) = Q(1,1) * M(1,1) + Q(1,2) * M(2,1)
-        R(2,2) = Q(2,1) * M(1,2) + Q(2,2) * M(2,2)
-        R(1,2) = Q(1,1) * M(1,2) + Q(1,2) * M(2,2)
-        R(2,1) = Q(2,1) * M(1,1) + Q(2,2) * M(2,1)
-        t(1) = R(1,1); t(2) = R(2,2)
-        t(3) = Q(3,3) * (t(3) * Q(3,3))
-        t(6) = 0.5_wp * (R(1,2) + R(2,1))
-        return
-      end if
-      T3(1,1) = t(1); T3(2,2) = t(2); T3(3,3) = t(3)
-      T3(2,3) = t(4); T3(3,2) = t(4)
-      T3(1,3) = t(5); T3(3,1) = t(5)
-      T3(1,2) = t(6); T3(2,1) = t(6)
-      R = matmul(Q, matmul(T3, transpose(Q)))
-      t(1) = R(1,1); t(2) = R(2,2); t(3) = R(3,3)
-      t(4) = 0.5_wp * (R(2,3) + R(3,2))
-      t(5) = 0.5_wp * (R(1,3) + R(3,1))
-      t(6) = 0.5_wp * (R(1,2) + R(2,1))
-    end subroutine rotate
-
-    ! F₁ = F₀ + Δt L F₀ (as advance_f in empm_tensor, here to be inlined). In plane strain L
-    ! and F have no 13, 23, 31, 32 entries and F₃₃ stays: only the in-plane block changes.
-    pure subroutine advance(dt, L, F0, F1)
-      real(wp), intent(in) :: dt, L(3,3), F0(3,3)
-      real(wp), intent(out) :: F1(3,3)
-      integer :: i, j
-      if (ntens == 4) then
-        F1 = F0
-        do j = 1, 2
-          do i = 1, 2
-            F1(i,j) = F0(i,j) + dt * (L(i,1) * F0(1,j) + L(i,2) * F0(2,j))
-          end do
-        end do
-        return
-      end if
-      do j = 1, 3
-        do i = 1, 3
-          F1(i,j) = F0(i,j) + dt * (L(i,1) * F0(1,j) + L(i,2) * F0(2,j) + L(i,3) * F0(3,j))
-        end do
-      end do
-    end subroutine advance
-
-    ! empm Voigt (xx, yy, zz, yz, xz, xy) → Abaqus (11, 22, 33, 12, 13, 23) with the shears
-    ! scaled by `g` (2 for engineering strains); NTENS = 4 keeps 12 only.
-    pure subroutine to_abaqus(v, g, a)
-      real(wp), intent(in) :: v(6), g
-      real(wp), intent(out) :: a(6)
-      a(1:3) = v(1:3)
-      a(4) = g * v(6)
-      a(5) = g * v(5)
-      a(6) = g * v(4)
-      if (ntens == 4) a(5:6) = 0.0_wp
-    end subroutine to_abaqus
-
-    pure subroutine from_abaqus(a, v)
-      real(wp), intent(in) :: a(6)
-      real(wp), intent(inout) :: v(6)
-      v(1:3) = a(1:3)
-      v(6) = a(4)
-      if (ntens == 6) then
-        v(5) = a(5); v(4) = a(6)
-      end if
-    end subroutine from_abaqus
   end subroutine update_batch
+
+  ! The step's rotation Q = (I − ½ΔtW)⁻¹(I + ½ΔtW), W = skew(L), with the formula (and the
+  ! operations) of jaumann_rotate in empm_plasticity, which the native rate-form models use:
+  ! the UMAT's stress is rotated exactly as theirs. spin = false when W = 0 (Q = I).
+  pure subroutine step_rotation(dt, L, Q, spin)
+    real(wp), intent(in) :: dt, L(3,3)
+    real(wp), intent(out) :: Q(3,3)
+    logical, intent(out) :: spin
+    real(wp) :: a(3), c
+    integer :: i, j
+    a(1) = 0.25_wp * dt * (L(3,2) - L(2,3))
+    a(2) = 0.25_wp * dt * (L(1,3) - L(3,1))
+    a(3) = 0.25_wp * dt * (L(2,1) - L(1,2))
+    Q = 0.0_wp
+    Q(1,1) = 1.0_wp; Q(2,2) = 1.0_wp; Q(3,3) = 1.0_wp
+    spin = .not. (a(1) == 0.0_wp .and. a(2) == 0.0_wp .and. a(3) == 0.0_wp)
+    if (.not. spin) return
+    c = 2.0_wp / (1.0_wp + a(1)**2 + a(2)**2 + a(3)**2)
+    do j = 1, 3
+      do i = 1, 3
+        Q(i,j) = c * a(i) * a(j)
+      end do
+    end do
+    Q(1,1) = Q(1,1) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
+    Q(2,2) = Q(2,2) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
+    Q(3,3) = Q(3,3) + 1.0_wp - c * (a(1)**2 + a(2)**2 + a(3)**2)
+    Q(1,2) = Q(1,2) - c * a(3); Q(2,1) = Q(2,1) + c * a(3)
+    Q(1,3) = Q(1,3) + c * a(2); Q(3,1) = Q(3,1) - c * a(2)
+    Q(2,3) = Q(2,3) - c * a(1); Q(3,2) = Q(3,2) + c * a(1)
+  end subroutine step_rotation
+
+  ! t ← Q t Qᵀ for a symmetric tensor in Voigt form (tensor shears), as jaumann_rotate does
+  ! (Q (t Qᵀ), then the symmetric part). In plane strain (ntens = 4) Q and t have no 13, 23
+  ! entries: the terms dropped are exact zeros, so the sums are the same.
+  pure subroutine rotate(ntens, Q, t)
+    integer(c_int), intent(in) :: ntens
+    real(wp), intent(in) :: Q(3,3)
+    real(wp), intent(inout) :: t(6)
+    real(wp) :: T3(3,3), R(3,3), M(3,3)
+    if (ntens == 4) then
+      M(1,1) = t(1) * Q(1,1) + t(6) * Q(1,2)
+      M(1,2) = t(1) * Q(2,1) + t(6) * Q(2,2)
+      M(2,1) = t(6) * Q(1,1) + t(2) * Q(1,2)
+      M(2,2) = t(6) * Q(2,1) + t(2) * Q(2,2)
+      R(1,1) = Q(1,1) * M(1,1) + Q(1,2) * M(2,1)
+      R(2,2) = Q(2,1) * M(1,2) + Q(2,2) * M(2,2)
+      R(1,2) = Q(1,1) * M(1,2) + Q(1,2) * M(2,2)
+      R(2,1) = Q(2,1) * M(1,1) + Q(2,2) * M(2,1)
+      t(1) = R(1,1); t(2) = R(2,2)
+      t(3) = Q(3,3) * (t(3) * Q(3,3))
+      t(6) = 0.5_wp * (R(1,2) + R(2,1))
+      return
+    end if
+    T3(1,1) = t(1); T3(2,2) = t(2); T3(3,3) = t(3)
+    T3(2,3) = t(4); T3(3,2) = t(4)
+    T3(1,3) = t(5); T3(3,1) = t(5)
+    T3(1,2) = t(6); T3(2,1) = t(6)
+    R = matmul(Q, matmul(T3, transpose(Q)))
+    t(1) = R(1,1); t(2) = R(2,2); t(3) = R(3,3)
+    t(4) = 0.5_wp * (R(2,3) + R(3,2))
+    t(5) = 0.5_wp * (R(1,3) + R(3,1))
+    t(6) = 0.5_wp * (R(1,2) + R(2,1))
+  end subroutine rotate
+
+  ! F₁ = F₀ + Δt L F₀ (as advance_f in empm_tensor, here to be inlined). In plane strain L
+  ! and F have no 13, 23, 31, 32 entries and F₃₃ stays: only the in-plane block changes.
+  pure subroutine advance(ntens, dt, L, F0, F1)
+    integer(c_int), intent(in) :: ntens
+    real(wp), intent(in) :: dt, L(3,3), F0(3,3)
+    real(wp), intent(out) :: F1(3,3)
+    integer :: i, j
+    if (ntens == 4) then
+      F1 = F0
+      do j = 1, 2
+        do i = 1, 2
+          F1(i,j) = F0(i,j) + dt * (L(i,1) * F0(1,j) + L(i,2) * F0(2,j))
+        end do
+      end do
+      return
+    end if
+    do j = 1, 3
+      do i = 1, 3
+        F1(i,j) = F0(i,j) + dt * (L(i,1) * F0(1,j) + L(i,2) * F0(2,j) + L(i,3) * F0(3,j))
+      end do
+    end do
+  end subroutine advance
+
+  ! empm Voigt (xx, yy, zz, yz, xz, xy) → Abaqus (11, 22, 33, 12, 13, 23) with the shears
+  ! scaled by `g` (2 for engineering strains); NTENS = 4 keeps 12 only.
+  pure subroutine to_abaqus(ntens, v, g, a)
+    integer(c_int), intent(in) :: ntens
+    real(wp), intent(in) :: v(6), g
+    real(wp), intent(out) :: a(6)
+    a(1:3) = v(1:3)
+    a(4) = g * v(6)
+    a(5) = g * v(5)
+    a(6) = g * v(4)
+    if (ntens == 4) a(5:6) = 0.0_wp
+  end subroutine to_abaqus
+
+  pure subroutine from_abaqus(ntens, a, v)
+    integer(c_int), intent(in) :: ntens
+    real(wp), intent(in) :: a(6)
+    real(wp), intent(inout) :: v(6)
+    v(1:3) = a(1:3)
+    v(6) = a(4)
+    if (ntens == 6) then
+      v(5) = a(5); v(4) = a(6)
+    end if
+  end subroutine from_abaqus
+
+  ! x is finite (neither Inf nor NaN), by its exponent bits: no floating-point comparison, so no
+  ! invalid-operation flag (trapped in Debug builds) for a NaN the UMAT returned.
+  elemental logical function finite(x)
+    real(wp), intent(in) :: x
+    integer(int64), parameter :: EXPONENT_BITS = int(z'7FF0000000000000', int64)
+    finite = iand(transfer(x, 1_int64), EXPONENT_BITS) /= EXPONENT_BITS
+  end function finite
 
   !> P-wave speed sqrt((λ + 2μ)/ρ) from the case's `E`/`nu` or `wave_modulus` [m/s].
   pure real(wp) function um_wave_speed(self, rho)

@@ -2,7 +2,7 @@
 """Run a reference case and a UMAT case with empm and compare their final states.
 
 usage: umat_compare.py EMPM REF.nml TEST.nml WORKDIR --tol T [--threads N]
-                       [--expect NAME OP VALUE ...]
+                       [--expect NAME OP VALUE ...] [--match NAME REFNAME ...]
 
 The fields final/stress, final/x and final/v of the two outputs must agree to T relative to the
 largest magnitude of the reference field: max|a - b| <= T max|a|. Each --expect checks a state
@@ -10,6 +10,9 @@ variable of the UMAT run: NAME (a dataset under final/state, e.g. umat_cuts), OP
   'eq'      every particle's value equals VALUE (VALUE 'steps' = the final step number,
             'time' = the final time; compared to 1e-12 relative)
   'maxgt'   the largest value exceeds VALUE
+Each --match compares the UMAT run's final/state/NAME (e.g. statev1) with the reference run's
+final/state/REFNAME (e.g. eps_p_eq) to T relative to max|REFNAME| (which must be > 0: the check
+is meant for a variable that evolved).
 Exit status 0 when every check passes, 1 otherwise (the figures are printed either way).
 """
 import subprocess
@@ -33,7 +36,7 @@ def run(empm, case, out, threads):
 def main(argv):
     empm, ref, test, work = argv[1:5]
     rest = argv[5:]
-    tol, threads, expects = None, None, []
+    tol, threads, expects, matches = None, None, [], []
     i = 0
     while i < len(rest):
         if rest[i] == '--tol':
@@ -42,6 +45,8 @@ def main(argv):
             threads = int(rest[i + 1]); i += 2
         elif rest[i] == '--expect':
             expects.append(rest[i + 1:i + 4]); i += 4
+        elif rest[i] == '--match':
+            matches.append(rest[i + 1:i + 3]); i += 3
         else:
             print(f'unknown argument {rest[i]}'); return 1
     os.makedirs(work, exist_ok=True)
@@ -64,6 +69,16 @@ def main(argv):
             ok = ok and good
             print(f"{'ok  ' if good else 'FAIL'} final/{f}: relative difference {err:.3e} "
                   f'(tolerance {tol:.1e})')
+        for var, ref in matches:
+            A = a['final/state/' + ref][()]
+            B = b['final/state/' + var][()]
+            scale = np.abs(A).max()
+            err = np.abs(A - B).max() / scale if scale > 0 else np.inf
+            good = A.shape == B.shape and err <= tol
+            ok = ok and good
+            print(f"{'ok  ' if good else 'FAIL'} state/{var} vs reference state/{ref} "
+                  f'(largest {scale:.3e}, {int((A != 0).sum())} of {A.size} nonzero): '
+                  f'relative difference {err:.3e} (tolerance {tol:.1e})')
         steps = float(b['final'].attrs['step'])
         time = float(b['final'].attrs['time'])
         for var, op, value in expects:
