@@ -111,11 +111,13 @@ contains
         emsg = path//': group &verify: key ''thresholds'': one per metric ('// &
           str(spec%nmetric)//' expected; -1 = reported only)'; return
       end if
-      if (expects) then
-        emsg = path//': group &verify: key ''expect_fail'': not supported for study = '// &
-          '''stress_point'''; return
-      end if
       spec%nlevel = count(levels > 0); spec%levels = levels
+      ! A known failure of a single run shows its signature as for a matrix run (an asserted
+      ! metric at least expect_excess times its bound); a stress point cannot abort.
+      if (expects .and. (spec%nlevel > 0 .or. expect_abort .or. .not. expect_excess > 1.0_wp)) then
+        emsg = path//': group &verify: key ''expect_fail'': a stress_point study declares a '// &
+          'known failure without levels and with ''expect_excess'' > 1'; return
+      end if
       if (spec%nlevel == 1 .or. any(levels(1:spec%nlevel) <= 0)) then
         emsg = path//': group &verify: key ''levels'': none, or at least two increment '// &
           'multipliers'; return
