@@ -2,9 +2,10 @@
 !>
 !> Each step: Δε = Δt·sym(L), ε ← ε + Δε, σ ← σ + D:Δε with the isotropic D (Lamé λ, μ),
 !> ρ ← ρ/(1 + tr Δε) (eq. 19). With `rate = 'jaumann'` (the default) the stress is first
-!> rotated with the spin of the step (σ ← σ + Δt(Wσ − σW), [[jaumann_rotate]]), so that a body
-!> in rigid rotation carries its stress with it; `rate = 'small_strain'` is the paper's update,
-!> which omits the rotation. The two agree wherever W = 0 (always in 1D). 1D uniaxial strain and 2D plane strain need no special case:
+!> rotated with the spin of the step (σ ← QσQᵀ, Q the orthogonal Cayley rotation of ΔtW,
+!> [[jaumann_rotate]]), so that a body in rigid rotation carries its stress with it;
+!> `rate = 'small_strain'` is the paper's update, which omits the rotation. The two agree
+!> wherever W = 0 (always in 1D). 1D uniaxial strain and 2D plane strain need no special case:
 !> the velocity gradient is zero in the unused directions, so the lateral stresses come out
 !> as λ·tr Δε by themselves. The small-strain model does not track the deformation gradient: F
 !> is left as it is (identity) — updating it cost a third of the stress phase's memory traffic and
@@ -183,7 +184,7 @@ contains
     class(empm_linear_elastic_t), intent(in) :: self !! material
     character(len=:), allocatable :: s               !! summary
     associate (unused_ => self); end associate
-    s = 'isotropic linear elasticity, small-strain hypoelastic update (the paper''s)'
+    s = 'isotropic linear elasticity, hypoelastic: Jaumann rate, or the paper''s small-strain update'
   end function le_summary
 
   !> Parameters: `density`, `E`, `nu` ([[empm_elastic_params]]) and `rate`.
