@@ -247,6 +247,28 @@ def disks_section(s):
             f"![Colliding disks energy]({savefig(fig, 'colliding_disks_energy.png')})", ""]
 
 
+def footing_section(s):
+    cases, _ = by_bench(s, "footing")
+    if not cases:
+        return []
+    fig, ax = plt.subplots(figsize=(7, 4))
+    for c in cases:
+        with h5(c["output"]) as f:
+            r = f["/history/reaction/footing/force"][:]
+            d = f["/history/reaction/footing/displacement"][:]
+        r, d = (r, d) if r.shape[0] == 2 else (r.T, d.T)
+        # c = 10 kPa, half-width B/2 = 0.5 m, B = 1 m (verification/footing.nml)
+        ax.plot(-d[1] / 1.0, -r[1] / 0.5 / 1.0e4, lw=1, label=c["id"].split("/", 2)[2])
+    ax.axhline(2 + np.pi, color="k", ls="--", lw=1, label="2 + π (Prandtl)")
+    ax.set_xlabel("δ / B"); ax.set_ylabel("p / c"); ax.grid(alpha=0.3); ax.legend(fontsize=7)
+    rows = [f"- `{c['id']}`: p_limit/((2+π)c) = {fmt(c['metrics'].get('limit_pressure_ratio'))}, "
+            f"{result(c)}" for c in cases]
+    return ["## Prandtl strip footing", "",
+            "Load–displacement curves of the rigid rough footing on Tresca clay (h = B/8; "
+            "docs/benchmarks.md); the limit pressure is the mean over the last quarter.", "",
+            f"![footing]({savefig(fig, 'footing.png')})", "", *rows, ""]
+
+
 def sp_array(f, name):
     """A (k, n+1) history written by Fortran as (k, 0:n): rows are the components."""
     a = f[name][:]
@@ -363,6 +385,7 @@ def main():
     lines += andersen_section(s)
     lines += disks_section(s)
     lines += stress_point_section(s)
+    lines += footing_section(s)
     extra = [("integrators/stability.png", "Integrator stability: spectral radius, damping, "
               "period error (docs/integrators.md)"),
              ("integrators/energy.png", "Energy histories per integrator"),

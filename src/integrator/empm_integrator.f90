@@ -35,6 +35,16 @@ module empm_integrator
                                          !! ([[assemble_forces]]); 0: none
     real(wp), allocatable :: tforce(:,:) !! nodal traction forces of the last assembly
                                          !! (ndim, nnode); allocated with tractions only
+    logical :: vol_smooth = .false.      !! replace each particle's volumetric strain rate by
+                                         !! its nodal average ([[update_stress]])
+    real(wp), allocatable :: vs_mass(:)  !! smoothing scratch: nodal mass (nnode)
+    real(wp), allocatable :: vs_q(:)     !! smoothing scratch: Σ_p N_Ip m_p tr L_p (nnode)
+    real(wp), allocatable :: vs_node(:,:) !! smoothing scratch: nodal average in every row
+                                         !! (ndim, nnode)
+    real(wp), allocatable :: vs_tr(:)    !! smoothing scratch: tr L_p (np)
+    real(wp), allocatable :: vs_w(:)     !! smoothing scratch: m_p tr L_p (np)
+    real(wp), allocatable :: vs_bar(:,:) !! smoothing scratch: interpolated average in every
+                                         !! row (ndim, np)
     type(empm_p2g_work_t) :: p2g         !! per-thread P2G buffers (sized in `prepare`)
     type(empm_phase_timer_t) :: timer    !! wall time per phase of the step, Newton iterations
   contains
@@ -102,6 +112,19 @@ contains
     if (stat /= 0) then
       call empm_raise_error(empm_alloc_error('traction work arrays', 0_int64, msg), err)
       return
+    end if
+    if (self%vol_smooth) then
+      if (allocated(self%vs_mass)) deallocate(self%vs_mass, self%vs_q, self%vs_node, &
+                                              self%vs_tr, self%vs_w, self%vs_bar)
+      allocate(self%vs_mass(model%grid%nnode), self%vs_q(model%grid%nnode), &
+               self%vs_node(model%grid%ndim, model%grid%nnode), self%vs_tr(model%pts%np), &
+               self%vs_w(model%pts%np), self%vs_bar(model%grid%ndim, model%pts%np), &
+               stat=stat, errmsg=msg)
+      if (stat /= 0) then
+        call empm_raise_error(empm_alloc_error('volumetric smoothing work arrays', &
+          8_int64 * (model%grid%ndim + 2) * (model%grid%nnode + model%pts%np), msg), err)
+        return
+      end if
     end if
     ! Threads are fixed here: P2G sums depend on the chunking, so it must not change mid-run.
     call self%p2g%init(model%grid%ndim, model%grid%nnode, model%pts%np, empm_max_threads())
@@ -339,13 +362,85 @@ contains
   !> `pts%state(:, q0:q1)` (contiguous, so passed without a copy; zero rows when no material
   !> has state variables) and uses its own first rows. On failure `stat` names the first
   !> failing particle.
-  subroutine update_stress(model, vel, dt, stat)
+  !>
+  !> With `integ` given and its `vol_smooth` set, the volumetric strain rate tr L_p of every
+  !> particle is replaced by its mass-weighted nodal average ([[smooth_volumetric]]) before the
+  !> material call: L_p += (ē_p − tr L_p)/ndim · I on the in-plane (2D) or full (3D) diagonal,
+  !> the deviatoric part of L_p unchanged. Without it the update is unchanged, bit for bit.
+  subroutine update_stress(model, vel, dt, stat, integ)
     type(empm_model_t), intent(inout) :: model      !! simulation state
     real(wp), intent(in), contiguous :: vel(:,:)    !! nodal velocities defining L (ndim, nnode)
     real(wp), intent(in) :: dt                      !! time step [s]
     type(empm_step_status_t), intent(inout) :: stat !! set on failure
+    class(empm_integrator_t), intent(inout), optional :: integ !! the scheme (smoothing option
+                                                    !! and its scratch)
+    real(wp) :: none1(0), none2(0, 0)
+    if (present(integ)) then
+      if (integ%vol_smooth) then
+        call smooth_volumetric(integ, model, vel)
+        call stress_blocks(model, vel, dt, stat, .true., integ%vs_tr, integ%vs_bar)
+        return
+      end if
+    end if
+    call stress_blocks(model, vel, dt, stat, .false., none1, none2)
+  end subroutine update_stress
+
+  !> Nodal averaging of the volumetric strain rate (a B-bar/F-bar-like projection for MPM):
+  !> ē_I = Σ_p N_Ip m_p tr L_p / Σ_p N_Ip m_p on every node with mass, then
+  !> ē_p = Σ_I N_Ip ē_I. One volumetric constraint per node instead of one per particle, which
+  !> removes the volumetric locking of isochoric (plastic, φ = ψ = 0) flow with several particles
+  !> per cell; a uniform tr L is reproduced (partition of unity), up to round-off. Results:
+  !> `integ%vs_tr` (tr L_p) and `integ%vs_bar` (ē_p in every row).
+  subroutine smooth_volumetric(integ, model, vel)
+    class(empm_integrator_t), intent(inout) :: integ !! the scheme (scratch, P2G workspace)
+    type(empm_model_t), intent(inout) :: model       !! simulation state
+    real(wp), intent(in), contiguous :: vel(:,:)     !! nodal velocities (ndim, nnode)
     real(wp) :: Lb(3, 3, STRESS_BLOCK)
-    integer :: r, i0, i1, info, im, n, nc, c, a, b, q0, q1, bad, p
+    integer :: np, d, nc, c, a, b, q0, q1, p, k, I
+    np = model%pts%np; d = model%grid%ndim
+    nc = empm_chunks(np)
+    !$omp parallel do default(none) schedule(static, 1) shared(model, vel, integ, np, nc, d) &
+    !$omp& private(a, b, q0, q1, p, k, Lb) if(nc > 1)
+    do c = 0, nc - 1
+      call empm_chunk_bounds(np, nc, c, a, b)
+      Lb = 0.0_wp
+      do q0 = a, b, STRESS_BLOCK
+        q1 = min(b, q0 + STRESS_BLOCK - 1)
+        call velocity_gradient(model%basis, vel, q0, q1, Lb)
+        do p = q0, q1
+          integ%vs_tr(p) = 0.0_wp
+          do k = 1, d
+            integ%vs_tr(p) = integ%vs_tr(p) + Lb(k, k, p - q0 + 1)
+          end do
+          integ%vs_w(p) = model%pts%m(p) * integ%vs_tr(p)
+        end do
+      end do
+    end do
+    !$omp end parallel do
+    integ%vs_mass = 0.0_wp; integ%vs_q = 0.0_wp
+    call p2g_mass(model%basis, model%pts%m(1:np), integ%vs_mass, integ%p2g)
+    call p2g_mass(model%basis, integ%vs_w(1:np), integ%vs_q, integ%p2g)
+    do I = 1, size(integ%vs_mass)
+      if (integ%vs_mass(I) > model%nodes%mass_tol) then
+        integ%vs_node(:, I) = integ%vs_q(I) / integ%vs_mass(I)
+      else
+        integ%vs_node(:, I) = 0.0_wp
+      end if
+    end do
+    call g2p_value(model%basis, integ%vs_node, integ%vs_bar)
+  end subroutine smooth_volumetric
+
+  !> The block loop of [[update_stress]]; with `sm`, L_p's volumetric part is replaced by
+  !> ē_p = `bar(1, p)` (`tr(p)` = tr L_p) before the material call.
+  subroutine stress_blocks(model, vel, dt, stat, sm, tr, bar)
+    type(empm_model_t), intent(inout) :: model
+    real(wp), intent(in), contiguous :: vel(:,:)
+    real(wp), intent(in) :: dt
+    type(empm_step_status_t), intent(inout) :: stat
+    logical, intent(in) :: sm
+    real(wp), intent(in) :: tr(:), bar(:,:)
+    real(wp) :: Lb(3, 3, STRESS_BLOCK), dv
+    integer :: r, i0, i1, info, im, n, nc, c, a, b, q0, q1, bad, p, k
     type(empm_material_ctx_t) :: ctx
     ctx%t = model%t; ctx%step = model%step + 1; ctx%ndim = model%grid%ndim
     ctx%h = minval(model%grid%h(1:model%grid%ndim))
@@ -356,8 +451,10 @@ contains
       nc = empm_chunks(n)
       ! The first failing particle of the run, whichever block it is in.
       bad = huge(1)
-      !$omp parallel do default(none) schedule(static, 1) shared(model, vel, dt, i0, im, n, nc) &
-      !$omp& private(a, b, q0, q1, p, Lb, info) firstprivate(ctx) reduction(min: bad) if(nc > 1)
+      !$omp parallel do default(none) schedule(static, 1) &
+      !$omp& shared(model, vel, dt, i0, im, n, nc, sm, tr, bar) &
+      !$omp& private(a, b, q0, q1, p, k, dv, Lb, info) firstprivate(ctx) reduction(min: bad) &
+      !$omp& if(nc > 1)
       do c = 0, nc - 1
         call empm_chunk_bounds(n, nc, c, a, b)
         a = a + i0 - 1; b = b + i0 - 1
@@ -365,6 +462,14 @@ contains
         do q0 = a, b, STRESS_BLOCK
           q1 = min(b, q0 + STRESS_BLOCK - 1)
           call velocity_gradient(model%basis, vel, q0, q1, Lb)
+          if (sm) then
+            do p = q0, q1
+              dv = (bar(1, p) - tr(p)) / ctx%ndim
+              do k = 1, ctx%ndim
+                Lb(k, k, p - q0 + 1) = Lb(k, k, p - q0 + 1) + dv
+              end do
+            end do
+          end if
           ctx%first = q0
           call model%mats(im)%model%update(dt, Lb(:, :, 1:q1 - q0 + 1), model%pts%F(:, :, q0:q1), &
             model%pts%strain(:, q0:q1), model%pts%stress(:, q0:q1), model%pts%state(:, q0:q1), &
@@ -381,5 +486,5 @@ contains
         return
       end if
     end do
-  end subroutine update_stress
+  end subroutine stress_blocks
 end module empm_integrator

@@ -67,7 +67,7 @@ contains
       if (stat%code /= STEP_OK) return
 
       if (self%variant == EULER_USF) then
-        call update_stress(model, nodes%vel, dt, stat)
+        call update_stress(model, nodes%vel, dt, stat, self)
         call tm%lap(PHASE_STRESS)
         if (stat%code /= STEP_OK) return
       end if
@@ -88,7 +88,7 @@ contains
 
       select case (self%variant)
       case (EULER_USL)
-        call update_stress(model, nodes%vel, dt, stat)
+        call update_stress(model, nodes%vel, dt, stat, self)
         call tm%lap(PHASE_STRESS)
       case (EULER_MUSL)
         ! Re-map momentum from the updated particle velocities (Sulsky's MUSL).
@@ -98,7 +98,7 @@ contains
         call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
         call nodes%constrain_velocity(nodes%vel, nodes%mom)
         call tm%lap(PHASE_GRID)
-        call update_stress(model, nodes%vel, dt, stat)
+        call update_stress(model, nodes%vel, dt, stat, self)
         call tm%lap(PHASE_STRESS)
       end select
     end associate

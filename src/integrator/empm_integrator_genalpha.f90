@@ -123,7 +123,7 @@ contains
       call tm%lap(PHASE_G2P)
       ! Strain with the nodal displacement actually applied: L = Σ (Δu_I/Δt) ⊗ ∇N.
       nodes%force = nodes%force / dt
-      call update_stress(model, nodes%force, dt, stat)
+      call update_stress(model, nodes%force, dt, stat, self)
       call tm%lap(PHASE_STRESS)
     end associate
   end subroutine ga_step

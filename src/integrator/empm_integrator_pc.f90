@@ -104,7 +104,7 @@ contains
       call map_velocity(self, model, stat, (1.0_wp - g) * dt, pts%a)
       if (stat%code /= STEP_OK) return
       ! Strain increment and stress with the predicted velocity.
-      call update_stress(model, nodes%vel, dt, stat)
+      call update_stress(model, nodes%vel, dt, stat, self)
       call tm%lap(PHASE_STRESS)
       if (stat%code /= STEP_OK) return
       ! Balance of forces at t + Δt; nodes%acc = f/m (zero on fixed dofs).

@@ -119,7 +119,11 @@ contains
         default='''musl'''), empm_run_params(), &
         empm_param('damping', PARAM_REAL, '-', 'local non-viscous damping alpha: nodal force '// &
           'f -= alpha |f| sign(v) (0: none; for reaching static equilibrium)', default='0', &
-          lo=0.0_wp, hi=1.0_wp, hi_open=.true.)]
+          lo=0.0_wp, hi=1.0_wp, hi_open=.true.), &
+        empm_param('volumetric_smoothing', PARAM_LOGICAL, '-', 'replace each particle''s '// &
+          'volumetric strain rate by its mass-weighted nodal average (against volumetric '// &
+          'locking in nearly incompressible plastic flow; docs/integrators.md)', &
+          default='.false.')]
     case ('loads')
       p = [ &
         empm_param('gravity', PARAM_REAL, 'm/s^2', 'gravity vector (final value)', &
@@ -742,6 +746,7 @@ contains
     character(len=:), allocatable :: scheme
     real(wp) :: cfl, dt, t_end, damping
     integer :: max_steps
+    logical :: vsmooth
     if (first(gs, 'integrator') == 0) then
       call missing_group(path, 'integrator', e); return
     end if
@@ -760,7 +765,13 @@ contains
     call g%get(p(5), max_steps, e)
     damping = 0.0_wp
     call g%get(p(6), damping, e)
+    vsmooth = .false.
+    call g%get(p(7), vsmooth, e)
     if (e%code /= EMPM_OK) return
+    if (vsmooth .and. cs%model%grid%ndim < 2) then
+      ! In 1D the volumetric strain rate is the whole strain rate: nothing would be left.
+      call g%fail(e, 'volumetric_smoothing', 'a 2D or 3D grid'); return
+    end if
     ! Exact override values (their text form above is for validation only).
     if (ov%cfl > 0.0_wp) cfl = ov%cfl
     if (ov%dt > 0.0_wp) dt = ov%dt
@@ -769,6 +780,7 @@ contains
     if (e%code /= EMPM_OK) return
     cs%scheme_name = cs%integ%name()
     cs%integ%damping = damping
+    cs%integ%vol_smooth = vsmooth
     cs%run%t_end = t_end; cs%run%cfl = cfl; cs%run%dt = dt; cs%run%max_steps = max_steps
   end subroutine read_integrator
 
