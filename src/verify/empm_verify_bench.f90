@@ -246,6 +246,27 @@ contains
           call noise_share(hist%t(1:hist%nt), hist%pv(1, k, 1:hist%nt), pv, self%fcut, value, info)
           if (info /= 0) emsg = 'noise_share: spectrum failed (status '//str(info)//')'
         end if
+      case ('history_rms_velocity', 'history_rms_velocity_current', 'history_rms_velocity_end')
+        ! RMS over time of the free-end probe's velocity error [m/s], the exact solution taken
+        ! at the probe particle's reference position (small-strain, Lagrangian), at its current
+        ! position x(t), or at the bar's end X = L (a fixed point in space).
+        if (hist%nprobe < 1) then
+          emsg = trim(name)//' needs a probe in the case file'; return
+        end if
+        if (trim(self%id) /= 'dyka') then
+          emsg = trim(name)//' is defined for the dyka benchmark only'; return
+        end if
+        call probe_exact(1, pv, ps)
+        if (trim(name) == 'history_rms_velocity_current') then
+          do k = 1, hist%nt
+            pv(k) = self%dyka%velocity(min(hist%px(1, 1, k), self%dyka%L), hist%t(k))
+          end do
+        else if (trim(name) == 'history_rms_velocity_end') then
+          do k = 1, hist%nt
+            pv(k) = self%dyka%velocity(self%dyka%L, hist%t(k))
+          end do
+        end if
+        value = history_l2(hist%t(1:hist%nt), hist%pv(1, 1, 1:hist%nt), pv)
       case ('base_stress_error')
         ! Bottom row of particles: sigma_yy against the exact column at their reference height.
         g = minval(pts%x0(2, 1:np))
