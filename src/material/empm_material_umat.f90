@@ -343,7 +343,9 @@ contains
     real(wp) :: temp, dtemp, predef(1), dpred(1), coords(3), celent, dtime, ddsdde(36)
     character(len=80) :: cmname
     integer(c_int) :: ndi, nshr, ntens, nstatv, nprops, noel, npt, layer, kspt, kstep, kinc
-    integer :: p, k, why, nsv, i
+    integer, parameter :: CHUNK = 64
+    real(wp) :: jac(CHUNK), a3c(CHUNK), cc(CHUNK)
+    integer :: p, p0, p1, k, why, nsv, i
     nsv = self%nstatv
     ! Copies: the UMAT receives them by reference and a careless one may write to them.
     props = 0.0_wp
@@ -362,7 +364,20 @@ contains
     do i = nsv + 1, nsv + NGUARD
       statev(i) = transfer(GUARD_BITS, 1.0_wp)
     end do
-    do p = 1, size(rho)
+    ! The density ρ ← ρ/(1 + tr Δε) afterwards, a chunk at a time in one vectorised division
+    ! (a division per particle inside the loop stalled it); a particle that failed keeps ρ
+    ! (divided by 1).
+    do p0 = 1, size(rho), CHUNK
+    p1 = min(size(rho), p0 + CHUNK - 1)
+    jac(1:p1 - p0 + 1) = 1.0_wp
+    ! The plane rotation's cos and sin for the chunk, in one vectorised pass (its division
+    ! per particle, next to the UMAT call, stalled the loop). Used when the spin is about z
+    ! alone (`single`); c = 2/(1 + a₃²) as in jaumann_rotate.
+    do p = p0, p1
+      a3c(p - p0 + 1) = 0.25_wp * dt * (L(2,1,p) - L(1,2,p))
+      cc(p - p0 + 1) = 2.0_wp / (1.0_wp + a3c(p - p0 + 1)**2)
+    end do
+    do p = p0, p1
       associate (Lp => L(:,:,p))
         de(1) = dt * Lp(1,1)
         de(2) = dt * Lp(2,2)
@@ -377,7 +392,20 @@ contains
         cycle
       end if
       noel = int(ctx%first + p - 1, c_int)
-      k = 1
+      ! The common case, one increment accepted: no copies of the particle beyond the UMAT's
+      ! own arguments (the general path below reruns a refused step from the particle's
+      ! unchanged values).
+      call single(L(:,:,p), a3c(p - p0 + 1), cc(p - p0 + 1), stress(:,p), strain(:,p), &
+        F(:,:,p), state(1:nsv + NEXTRA, p), why, pnewdt)
+      if (why == 0) then
+        jac(p - p0 + 1) = 1.0_wp + tr
+        cycle
+      end if
+      if (why /= WHY_PNEWDT) then
+        call fail(p, why)
+        cycle
+      end if
+      k = min(UMAT_MAX_SUB, max(2, ceiling(1.0_wp / max(pnewdt, 1.0_wp / UMAT_MAX_SUB))))
       do
         call increments(L(:,:,p), stress(:,p), strain(:,p), F(:,:,p), state(1:nsv + NEXTRA, p), &
           k, why, pnewdt)
@@ -391,7 +419,9 @@ contains
         cycle
       end if
       if (k > 1) state(nsv + NEXTRA, p) = state(nsv + NEXTRA, p) + 1.0_wp
-      rho(p) = rho(p) / (1.0_wp + tr)
+      jac(p - p0 + 1) = 1.0_wp + tr
+    end do
+    rho(p0:p1) = rho(p0:p1) / jac(1:p1 - p0 + 1)
     end do
 
   contains
@@ -402,6 +432,103 @@ contains
       !$omp atomic write
       self%why = code
     end subroutine fail
+
+    ! One particle's step in one increment (k = 1 of `increments`, with the same arithmetic),
+    ! writing the particle only when the UMAT's result is accepted; why and pnewdt as there.
+    subroutine single(Lp, a3, c, sp, ep, Fp, stp, why, pnewdt)
+      real(wp), intent(in) :: Lp(3,3)
+      real(wp), intent(in) :: a3, c  ! ¼Δt(L₂₁ − L₁₂) and 2/(1 + a3²)
+      real(wp), intent(inout) :: sp(6), ep(6), Fp(3,3), stp(nsv + NEXTRA)
+      integer, intent(out) :: why
+      real(wp), intent(out) :: pnewdt
+      real(wp) :: drot(3,3), F1(3,3), sig(6), stran(6), dstran(6), s(6), e(6)
+      integer(int64) :: g
+      integer :: i
+      logical :: spin
+      real(wp) :: ct, st
+      e = ep
+      if (ntens == 4 .and. Lp(3,2) == Lp(2,3) .and. Lp(1,3) == Lp(3,1)) then
+        ! Plane strain and 1D (spin about z alone): the closed form of `rotate` written
+        ! straight into the Abaqus order, scalar by scalar (no round trip through memory).
+        drot = 0.0_wp
+        drot(3,3) = 1.0_wp
+        if (a3 /= 0.0_wp) then
+          ct = 1.0_wp - c * a3**2; st = c * a3
+          sig(1) = ct * ct * sp(1) - 2.0_wp * ct * st * sp(6) + st * st * sp(2)
+          sig(2) = st * st * sp(1) + 2.0_wp * ct * st * sp(6) + ct * ct * sp(2)
+          sig(4) = ct * st * (sp(1) - sp(2)) + (ct * ct - st * st) * sp(6)
+          if (self%uses_stran) then
+            stran(1) = ct * ct * e(1) - 2.0_wp * ct * st * e(6) + st * st * e(2)
+            stran(2) = st * st * e(1) + 2.0_wp * ct * st * e(6) + ct * ct * e(2)
+            e(6) = ct * st * (e(1) - e(2)) + (ct * ct - st * st) * e(6)
+            e(1) = stran(1); e(2) = stran(2)
+          end if
+        else
+          ct = 1.0_wp; st = 0.0_wp
+          sig(1) = sp(1); sig(2) = sp(2); sig(4) = sp(6)
+        end if
+        drot(1,1) = ct; drot(2,2) = ct; drot(2,1) = st; drot(1,2) = -st
+        sig(3) = sp(3)
+        stran(1) = e(1); stran(2) = e(2); stran(3) = e(3); stran(4) = 2.0_wp * e(6)
+        dstran(1) = de(1); dstran(2) = de(2); dstran(3) = de(3); dstran(4) = 2.0_wp * de(6)
+      else
+        s = sp
+        call step_rotation(dt, Lp, drot, spin)
+        if (spin) then
+          call rotate(drot, s)
+          if (self%uses_stran) call rotate(drot, e)
+        end if
+        call to_abaqus(ntens, s, 1.0_wp, sig)
+        call to_abaqus(ntens, e, 2.0_wp, stran)
+        call to_abaqus(ntens, de, 2.0_wp, dstran)
+      end if
+      do i = 1, nsv
+        statev(i) = stp(i)
+      end do
+      sse = stp(nsv + 1); spd = stp(nsv + 2); scd = stp(nsv + 3)
+      time = ctx%t
+      dtime = dt
+      pnewdt = 1.0e36_wp
+      if (self%uses_dfgrd) then
+        call advance(ntens, dt, Lp, Fp, F1)
+        call umat(sig, statev, ddsdde, sse, spd, scd, rpl, ddsddt, drplde, drpldt, stran, &
+          dstran, time, dtime, temp, dtemp, predef, dpred, cmname, ndi, nshr, ntens, &
+          nstatv, props, nprops, coords, drot, pnewdt, celent, Fp, F1, noel, npt, &
+          layer, kspt, kstep, kinc, int(len(cmname), c_size_t))
+      else
+        ! DFGRD0 = DFGRD1 = F (inputs the UMAT must not change; a copy keeps a careless one
+        ! from changing the particle's F).
+        F1 = Fp
+        call umat(sig, statev, ddsdde, sse, spd, scd, rpl, ddsddt, drplde, drpldt, stran, &
+          dstran, time, dtime, temp, dtemp, predef, dpred, cmname, ndi, nshr, ntens, &
+          nstatv, props, nprops, coords, drot, pnewdt, celent, F1, F1, noel, npt, &
+          layer, kspt, kstep, kinc, int(len(cmname), c_size_t))
+      end if
+      ! Guards bit for bit, all at once (one branch).
+      g = 0
+      do i = nsv + 1, nsv + NGUARD
+        g = ior(g, ieor(transfer(statev(i), GUARD_BITS), GUARD_BITS))
+      end do
+      if (g /= 0) then
+        why = WHY_NSTATV; return
+      end if
+      do i = 1, ntens
+        if (.not. finite(sig(i))) then
+          why = WHY_NONFINITE; return
+        end if
+      end do
+      if (pnewdt < 1.0_wp) then
+        why = WHY_PNEWDT; return
+      end if
+      why = 0
+      call from_abaqus(ntens, sig, sp)
+      ep = e + de
+      if (self%uses_dfgrd) Fp = F1
+      do i = 1, nsv
+        stp(i) = statev(i)
+      end do
+      stp(nsv + 1) = sse; stp(nsv + 2) = spd; stp(nsv + 3) = scd
+    end subroutine single
 
     ! One particle's step in k equal sub-increments, on local copies that are stored only when
     ! every sub-increment succeeded (so a refusal or a failure leaves the particle as it was).
@@ -432,8 +559,8 @@ contains
       call step_rotation(h, Lp, drot, spin)
       do j = 1, k
         if (spin) then
-          call rotate(ntens, drot, s)
-          if (self%uses_stran) call rotate(ntens, drot, e)
+          call rotate(drot, s)
+          if (self%uses_stran) call rotate(drot, e)
         end if
         if (self%uses_dfgrd) then
           call advance(ntens, h, Lp, F0, F1)
@@ -475,9 +602,10 @@ contains
     end subroutine increments
   end subroutine update_batch
 
-  ! The step's rotation Q = (I − ½ΔtW)⁻¹(I + ½ΔtW), W = skew(L), with the formula (and the
-  ! operations) of jaumann_rotate in empm_plasticity, which the native rate-form models use:
-  ! the UMAT's stress is rotated exactly as theirs. spin = false when W = 0 (Q = I).
+  ! The step's rotation Q = (I − ½ΔtW)⁻¹(I + ½ΔtW), W = skew(L), with the formula of
+  ! jaumann_rotate in empm_plasticity, which the native rate-form models use: the UMAT's stress
+  ! is rotated as theirs. spin = false when W = 0 (Q = I). A spin about z alone (every 2D
+  ! step) gives the in-plane rotation cos = 1 − c a₃², sin = c a₃ and Q₃₃ = 1 exactly.
   pure subroutine step_rotation(dt, L, Q, spin)
     real(wp), intent(in) :: dt, L(3,3)
     real(wp), intent(out) :: Q(3,3)
@@ -489,8 +617,15 @@ contains
     a(3) = 0.25_wp * dt * (L(2,1) - L(1,2))
     Q = 0.0_wp
     Q(1,1) = 1.0_wp; Q(2,2) = 1.0_wp; Q(3,3) = 1.0_wp
-    spin = .not. (a(1) == 0.0_wp .and. a(2) == 0.0_wp .and. a(3) == 0.0_wp)
-    if (.not. spin) return
+    if (a(1) == 0.0_wp .and. a(2) == 0.0_wp) then
+      spin = a(3) /= 0.0_wp
+      if (.not. spin) return
+      c = 2.0_wp / (1.0_wp + a(3)**2)
+      Q(1,1) = 1.0_wp - c * a(3)**2; Q(2,2) = Q(1,1)
+      Q(2,1) = c * a(3); Q(1,2) = -Q(2,1)
+      return
+    end if
+    spin = .true.
     c = 2.0_wp / (1.0_wp + a(1)**2 + a(2)**2 + a(3)**2)
     do j = 1, 3
       do i = 1, 3
@@ -505,26 +640,22 @@ contains
     Q(2,3) = Q(2,3) - c * a(1); Q(3,2) = Q(3,2) + c * a(1)
   end subroutine step_rotation
 
-  ! t ← Q t Qᵀ for a symmetric tensor in Voigt form (tensor shears), as jaumann_rotate does
-  ! (Q (t Qᵀ), then the symmetric part). In plane strain (ntens = 4) Q and t have no 13, 23
-  ! entries: the terms dropped are exact zeros, so the sums are the same.
-  pure subroutine rotate(ntens, Q, t)
-    integer(c_int), intent(in) :: ntens
+  ! t ← Q t Qᵀ for a symmetric tensor in Voigt form (tensor shears), as jaumann_rotate does: for
+  ! an in-plane Q (Q₁₃ = Q₂₃ = Q₃₁ = Q₃₂ = 0, Q₃₃ = 1: every 2D step) its closed form with
+  ! cos = Q₁₁, sin = Q₂₁, otherwise Q (t Qᵀ) and the symmetric part.
+  pure subroutine rotate(Q, t)
     real(wp), intent(in) :: Q(3,3)
     real(wp), intent(inout) :: t(6)
-    real(wp) :: T3(3,3), R(3,3), M(3,3)
-    if (ntens == 4) then
-      M(1,1) = t(1) * Q(1,1) + t(6) * Q(1,2)
-      M(1,2) = t(1) * Q(2,1) + t(6) * Q(2,2)
-      M(2,1) = t(6) * Q(1,1) + t(2) * Q(1,2)
-      M(2,2) = t(6) * Q(2,1) + t(2) * Q(2,2)
-      R(1,1) = Q(1,1) * M(1,1) + Q(1,2) * M(2,1)
-      R(2,2) = Q(2,1) * M(1,2) + Q(2,2) * M(2,2)
-      R(1,2) = Q(1,1) * M(1,2) + Q(1,2) * M(2,2)
-      R(2,1) = Q(2,1) * M(1,1) + Q(2,2) * M(2,1)
-      t(1) = R(1,1); t(2) = R(2,2)
-      t(3) = Q(3,3) * (t(3) * Q(3,3))
-      t(6) = 0.5_wp * (R(1,2) + R(2,1))
+    real(wp) :: T3(3,3), R(3,3), ct, st, t11, t22, t12, t13
+    if (Q(1,3) == 0.0_wp .and. Q(2,3) == 0.0_wp .and. Q(3,1) == 0.0_wp .and. &
+        Q(3,2) == 0.0_wp .and. Q(3,3) == 1.0_wp) then
+      ct = Q(1,1); st = Q(2,1)
+      t11 = ct * ct * t(1) - 2.0_wp * ct * st * t(6) + st * st * t(2)
+      t22 = st * st * t(1) + 2.0_wp * ct * st * t(6) + ct * ct * t(2)
+      t12 = ct * st * (t(1) - t(2)) + (ct * ct - st * st) * t(6)
+      t13 = ct * t(5) - st * t(4)
+      t(4) = st * t(5) + ct * t(4)
+      t(1) = t11; t(2) = t22; t(5) = t13; t(6) = t12
       return
     end if
     T3(1,1) = t(1); T3(2,2) = t(2); T3(3,3) = t(3)
