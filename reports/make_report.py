@@ -69,19 +69,56 @@ def by_bench(s, bench):
             [c for c in s["convergence"] if c["id"].split("/")[0] == bench])
 
 
-def convergence_section(conv, name, title):
+# Axis labels of convergence plots: the refined parameter and the error, named, normalised
+# and with units (the scales are the benchmark's, docs/verification.md).
+PARAM_LABEL = {"h": "grid spacing h [m]",
+               "cfl": "Courant number CFL = c Δt / h [–]",
+               "dt": "time step Δt [s]"}
+METRIC_LABEL = {
+    "displacement_l2": "displacement error ‖u − u_exact‖₂ / u_ref [–]",
+    "velocity_l2": "velocity error ‖v − v_exact‖₂ / v_ref [–]",
+    "history_l2_velocity": "free-end velocity history error ‖v − v_exact‖ / v₀ [–]",
+    "temporal_velocity_l2": "velocity error vs the Δt/8 run ‖v − v_ref‖₂ / v_ref [–]",
+    "closed_form_error": "stress error |σ − Qσ₀Qᵀ| / |σ₀| [–]"}
+# Distinguishable curves: colour, line style and marker all vary.
+STYLES = [(plt.get_cmap("tab10").colors[k % 10], ["-", "--", "-.", ":"][k % 4], "osD^v<>"[k % 7])
+          for k in range(40)]
+
+
+def reference_slopes(ax, x, y, orders=(1, 2)):
+    """Grey reference lines of slope `orders` through the geometric middle of the data."""
+    x = np.asarray(x, float); y = np.asarray(y, float)
+    ok = np.isfinite(y) & (y > 0)
+    if ok.sum() < 2:
+        return
+    xs = np.array([x[ok].min(), x[ok].max()])
+    xm, ym = np.sqrt(xs[0] * xs[1]), np.exp(np.mean(np.log(y[ok])))
+    for k, q in enumerate(orders):
+        ax.loglog(xs, ym * (xs / xm) ** q, color="0.45", lw=1.0,
+                  ls=["--", ":"][k % 2], zorder=0)
+        ax.annotate(f"slope {q}", (xs[0], ym * (xs[0] / xm) ** q), fontsize=7, color="0.35",
+                    xytext=(2, -10 if q > 1 else 3), textcoords="offset points")
+
+
+def convergence_section(conv, name, title, exact):
+    """A log-log plot of the studies in `conv` (observed order in each legend entry, reference
+    slopes 1 and 2), a caption saying what `exact` is, and the table of levels and orders."""
     if not conv:
         return []
-    fig, ax = plt.subplots(figsize=(6.4, 4.6))
+    fig, ax = plt.subplots(figsize=(7.0, 5.0))
     rows = ["| study | values | errors | observed orders | fitted | bounds | result |",
             "|---|---|---|---|---|---|---|"]
-    for c in conv:
+    allx, ally = [], []
+    for k, c in enumerate(conv):
         h, e = np.array(c["values"]), np.array(c["errors"])
         ok = np.all(np.isfinite(e)) and np.all(e > 0) and np.all(e < 1e300)
         if ok:
-            ax.loglog(h, e, "o-", label=f"{'/'.join(c['id'].split('/')[1:])} "
-                                        f"({c['observed_order']:.2f})")
+            col, ls, mk = STYLES[k % len(STYLES)]
+            label = "/".join(x for x in c["id"].split("/")[1:] if x not in ("space", "time"))
+            ax.loglog(h, e, color=col, ls=ls, marker=mk, ms=4, lw=1.2,
+                      label=f"{label}: order {c['observed_order']:.2f}")
             orders = np.log(e[:-1] / e[1:]) / np.log(h[:-1] / h[1:])
+            allx += list(h); ally += list(e)
         else:
             orders = []
         bound = f"≥ {fmt(c['min_order'])}" if c.get("min_order", -1e300) > -99 else ""
@@ -92,12 +129,27 @@ def convergence_section(conv, name, title):
         rows.append(f"| `{c['id']}` | {', '.join(fmt(x) for x in h)} | "
                     f"{', '.join(fmt(x) for x in e)} | {', '.join(f'{o:.2f}' for o in orders)} | "
                     f"{fmt(c.get('fitted_order'))} | {bound} | {result(c)} |")
-    ax.set_xlabel(conv[0]["parameter"].strip())
-    ax.set_ylabel(conv[0]["metric"])
+    reference_slopes(ax, allx, ally)
+    # Ticks at the refinement levels themselves, in plain numbers.
+    ticks = sorted(set(allx))
+    if ticks:
+        ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+        ax.set_xticks(ticks)
+        ax.set_xticklabels([f"{t:.3g}" for t in ticks], fontsize=7)
+    par, met = conv[0]["parameter"].strip(), conv[0]["metric"].strip()
+    if met == "temporal_velocity_l2":
+        exact = ("a run on the same grid with a time step 8 times smaller than the study's "
+                 "smallest, so that the error is the temporal one alone")
+    ax.set_xlabel(PARAM_LABEL.get(par, par))
+    ax.set_ylabel(METRIC_LABEL.get(met, met))
     ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=6)
-    ax.set_title(title)
-    return [f"![{title}]({savefig(fig, name)})", "", *rows, ""]
+    ax.legend(fontsize=6, ncol=1 if len(conv) < 9 else 2, title="observed order (last pair)",
+              title_fontsize=6)
+    ax.set_title(title, fontsize=10)
+    caption = (f"*{title}.* Exact: {exact}. Errors are relative to the benchmark's scale "
+               "(u_ref, v_ref: docs/verification.md). Grey lines: slopes 1 (dashed) and 2 "
+               "(dotted). The legend gives the order observed between the two finest levels.")
+    return [f"![{title}]({savefig(fig, name)})", "", caption, "", *rows, ""]
 
 
 def dyka_section(s):
@@ -178,7 +230,9 @@ def dyka_section(s):
             "update, second order, oscillates like forward Euler. The paper attributes the "
             "smoothing to the predictor-corrector idea; our measurements attribute it to the "
             "published particle update's dissipation.", ""]
-    out += convergence_section(conv, "dyka_convergence.png", "Dyka bar: mesh refinement")
+    out += convergence_section(conv, "dyka_convergence.png", "Dyka bar: mesh refinement",
+                               "the solution by characteristics (d'Alembert with reflections) "
+                               "at the probe particle's reference position")
     return out
 
 
@@ -407,7 +461,8 @@ def stress_point_section(s):
         ax.legend(fontsize=7)
         lines += [f"![MCC]({savefig(fig, 'stress_point_mcc.png')})", ""]
     lines += convergence_section(conv, "objectivity.png",
-                                 "Objectivity: rigid rotation by 90°, error vs Δt")
+                                 "Objectivity: rigid rotation by 90°, error vs Δt",
+                                 "the initial stress rotated rigidly, Q σ₀ Qᵀ (90°)")
     return lines
 
 
@@ -430,19 +485,24 @@ def main():
              "`/verification` with the exact fields); machine-readable summary: "
              "`reports/summary.json`.", ""]
     lines += dyka_section(s)
-    for bench, title in [("vibrating_bar", "Vibrating bar"),
-                         ("mms_linear_1d", "Manufactured solution, small strain, 1D"),
-                         ("mms_linear_2d", "Manufactured solution, small strain, 2D"),
-                         ("mms_neohookean_1d", "Manufactured solution, neo-Hookean 1D (Steffen)"),
-                         ("mms_axis_aligned_2d",
-                          "Manufactured solution, axis-aligned 2D (Wallstedt & Guilkey)")]:
+    mms = ("the manufactured solution evaluated at the particles' reference positions "
+           "(its body force imposed exactly)")
+    for bench, title, exact in [
+            ("vibrating_bar", "Vibrating bar",
+             "the first mode of the continuous bar, u = (v₀/ω) sin(ωt) sin(βX), at the "
+             "particles' reference positions"),
+            ("mms_linear_1d", "Manufactured solution, small strain, 1D", mms),
+            ("mms_linear_2d", "Manufactured solution, small strain, 2D", mms),
+            ("mms_neohookean_1d", "Manufactured solution, neo-Hookean 1D (Steffen)", mms),
+            ("mms_axis_aligned_2d",
+             "Manufactured solution, axis-aligned 2D (Wallstedt & Guilkey)", mms)]:
         _, conv = by_bench(s, bench)
         if conv:
             lines += [f"## {title}", ""]
             space = [c for c in conv if "/space/" in c["id"]]
             time = [c for c in conv if "/time/" in c["id"]]
-            lines += convergence_section(space, f"{bench}_space.png", f"{title}: space")
-            lines += convergence_section(time, f"{bench}_time.png", f"{title}: time")
+            lines += convergence_section(space, f"{bench}_space.png", f"{title}: space", exact)
+            lines += convergence_section(time, f"{bench}_time.png", f"{title}: time", exact)
     lines += andersen_section(s)
     lines += disks_section(s)
     lines += stress_point_section(s)
