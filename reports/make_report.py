@@ -331,7 +331,9 @@ def andersen_section(s):
     a2.set_xlabel("σ_yy [MPa]"); a2.set_ylabel("Y (reference height) [m]"); a2.grid(alpha=0.3)
     a1.legend(fontsize=6); a2.legend(fontsize=6)
     out += [f"![Andersen block]({savefig(fig, 'andersen.png')})", "",
-            "Vertical stress of the base material point against time (the paper's figure 12):", "",
+            "Vertical stress of the base material point against time (the paper's figure 12); "
+            "black: the exact column under the eq.-(46) ramp (modal solution, "
+            "`empm_exact_column`) at that particle's reference height:", "",
             f"![Andersen base stress]({fig12})", ""]
     stable = [c for c in cases if c["passed"] and not c.get("expected_failure")]
     failed = [c for c in cases if c.get("expected_failure")]
