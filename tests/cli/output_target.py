@@ -10,6 +10,9 @@
   directory   a folder as -o: refused (status 2), no partial or XDMF file left.
   disk_full   the file-size limit (RLIMIT_FSIZE) below the output size: status 4, one
               message with the system's reason, no HDF5 error stack, no crash, no file left.
+  xdmf_fails  the XDMF file cannot be put in place (a folder appears at OUT.xmf during the
+              run): status 4 with the system's reason, the XDMF partial removed, the folder
+              untouched, the HDF5 file complete.
 
 usage: output_target.py EMPM CASE_DIR WORK_DIR SCENARIO
 Exit 0 pass, 1 fail, 77 skipped (CTest SKIP_RETURN_CODE).
@@ -159,13 +162,45 @@ def disk_full(empm, cases, work):
         fail(f"left behind: {os.listdir(work)}")
 
 
+def xdmf_fails(empm, cases, work):
+    case = os.path.join(cases, "long.nml")  # about 1 s in a Debug build
+    out, xmf = "xf.h5", os.path.join(work, "xf.xmf")
+    a = subprocess.Popen([empm, "run", case, "-o", out], cwd=work, stdout=subprocess.PIPE,
+                         stderr=subprocess.PIPE, text=True)
+    lock = os.path.join(work, out + ".lock")
+    t0 = time.time()
+    while not os.path.exists(lock) and a.poll() is None and time.time() - t0 < 30:
+        time.sleep(0.005)
+    if a.poll() is not None:
+        fail("the run ended before the folder could be made (case too short)")
+    # After the run's up-front checks: the XDMF file's final rename must fail.
+    os.mkdir(xmf)
+    with open(os.path.join(xmf, "keep"), "w") as f:
+        f.write("x\n")
+    a_out, a_err = a.communicate(timeout=120)
+    print(f"run -> status {a.returncode}\n{a_out}{a_err}")
+    if a.returncode != 4:
+        fail(f"status {a.returncode}, expected 4")
+    if "xf.xmf" not in a_err or ("Is a directory" not in a_err and
+                                 "Directory not empty" not in a_err):
+        fail("the message does not name the XDMF file and the system's reason")
+    if a_err.count("error:") != 1 or "Backtrace" in a_err:
+        fail("expected exactly one error line and no backtrace")
+    if leftovers(work):
+        fail(f"left behind: {leftovers(work)}")
+    if os.listdir(xmf) != ["keep"]:
+        fail(f"the folder at the XDMF path was changed: {os.listdir(xmf)}")
+    check_complete(os.path.join(work, out))
+
+
 def main():
     empm, cases, work, scenario = sys.argv[1:5]
     work = os.path.join(work, scenario)
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     {"concurrent": concurrent, "stale_lock": stale_lock, "fifo": fifo,
-     "directory": directory, "disk_full": disk_full}[scenario](empm, cases, work)
+     "directory": directory, "disk_full": disk_full,
+     "xdmf_fails": xdmf_fails}[scenario](empm, cases, work)
     print("PASS")
 
 
