@@ -3,16 +3,17 @@ program empm_main
   use, intrinsic :: iso_fortran_env, only: output_unit, error_unit
   use empm, only: empm_version, empm_run_case, empm_error_t
   use empm_terminal, only: empm_exit
+  use empm_error, only: EMPM_ERR_INTERRUPTED
   use empm_parallel, only: empm_set_threads
   use empm_solver, only: empm_run_stats_t, empm_run_summary
   use empm_files, only: empm_mkdir_p
-  use empm_posix, only: empm_ignore_sigxfsz
+  use empm_posix, only: empm_ignore_sigxfsz, empm_catch_stop_signals, empm_stop_signal
   use empm_verify_suite, only: empm_verify_run
   use empm_input, only: empm_input_markdown
   use empm_bench, only: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json
   implicit none
   integer :: nargs, i, ios, nfail, npat, nthreads
-  character(len=:), allocatable :: cmd, case_file, out_file, written, manifest, outdir
+  character(len=:), allocatable :: cmd, case_file, out_file, written, manifest, outdir, restart
   character(len=256), allocatable :: patterns(:)
   character(len=64) :: numtext
   logical :: quick
@@ -32,7 +33,7 @@ program empm_main
   case ('-V', '--version', 'version')
     write(output_unit, '(a)') 'empm '//empm_version()
   case ('run')
-    case_file = ''; out_file = ''; nthreads = 0
+    case_file = ''; out_file = ''; nthreads = 0; restart = ''
     i = 2
     do while (i <= nargs)
       select case (arg(i))
@@ -45,6 +46,9 @@ program empm_main
         if (i == nargs) call die('option '//arg(i)//' needs a value')
         nthreads = int_arg(i); i = i + 2
         if (nthreads < 1) call die('option --threads needs a positive integer')
+      case ('-r', '--restart')
+        if (i == nargs) call die('option '//arg(i)//' needs a checkpoint file')
+        restart = arg(i + 1); i = i + 2
       case default
         if (index(arg(i), '-') == 1) call die('unknown option '//arg(i))
         if (len(case_file) > 0) call die('only one case file per run (got '//case_file// &
@@ -56,12 +60,18 @@ program empm_main
     if (nthreads > 0) call empm_set_threads(nthreads)
     ! Beyond the file-size limit (ulimit -f) a write fails and is reported (status 4).
     call empm_ignore_sigxfsz()
+    ! Ctrl-C or a batch system's SIGTERM: a checkpoint and the results so far, then exit.
+    call empm_catch_stop_signals()
     ! A verification case file also runs: its &verify group is the suite's, not the run's.
     call empm_run_case(case_file, out_file, written=written, err=err, extra_groups='verify', &
-                       stats=stats)
+                       stats=stats, restart=restart)
     ! The summary also for a run stopped by a guard (whenever the time loop ran).
     if (stats%ran) write(output_unit, '(a)', iostat=ios) 'empm: '//empm_run_summary(stats)
-    if (err%code /= 0) then
+    if (err%code == EMPM_ERR_INTERRUPTED) then
+      ! As shells report a process ended by a signal: 128 + its number.
+      write(error_unit, '(a)') 'empm: '//err%message
+      call empm_exit(128 + empm_stop_signal())
+    else if (err%code /= 0) then
       write(error_unit, '(a)') 'empm: error: '//err%message
       call empm_exit(err%code)
     end if
@@ -171,7 +181,7 @@ contains
 
   subroutine usage_run(u)
     integer, intent(in) :: u
-    write(u, '(a)') 'usage: empm run CASE.nml [-o OUT.h5] [--threads N]'
+    write(u, '(a)') 'usage: empm run CASE.nml [-o OUT.h5] [--threads N] [--restart CKPT.h5]'
     write(u, '(a)') ''
     write(u, '(a)') 'Runs the case file CASE.nml (keys: empm keys, docs/input.md) and writes OUT.h5'
     write(u, '(a)') 'and OUT.xmf for ParaView (docs/output.md, docs/paraview.md). The first'
@@ -179,6 +189,10 @@ contains
     write(u, '(a)') ''
     write(u, '(a)') '  -o, --output OUT.h5  output file (default: the &output file, else CASE.h5)'
     write(u, '(a)') '  -t, --threads N      OpenMP threads (default: OMP_NUM_THREADS or all cores)'
+    write(u, '(a)') '  -r, --restart CKPT.h5  continue from a checkpoint of this case file (written'
+    write(u, '(a)') '                       with &output checkpoint_every / checkpoint_seconds, or'
+    write(u, '(a)') '                       on SIGINT/SIGTERM): the results equal an uninterrupted'
+    write(u, '(a)') '                       run''s, bitwise with the same number of threads'
     write(u, '(a)') '  -h, --help           this text'
     write(u, '(a)') ''
     write(u, '(a)') 'Progress goes to stderr: one updated line on a terminal, a plain line every'
@@ -188,7 +202,9 @@ contains
     write(u, '(a)') ''
     write(u, '(a)') 'exit status: 0 success, 1 usage error, 2 invalid case file,'
     write(u, '(a)') '             3 run stopped by a guard (results marked incomplete), 4 I/O error'
-    write(u, '(a)') '             (also when another run is writing OUT.h5: its lock OUT.h5.lock)'
+    write(u, '(a)') '             (also when another run is writing OUT.h5: its lock OUT.h5.lock),'
+    write(u, '(a)') '             130 / 143 stopped by SIGINT / SIGTERM (a checkpoint OUT.ckpt.h5 and'
+    write(u, '(a)') '             the results so far, marked incomplete, written first)'
   end subroutine usage_run
 
   subroutine usage_verify(u)

@@ -27,6 +27,7 @@ extern "C" {
 #define EMPM_ERR_INPUT 2   /* invalid case file or input value */
 #define EMPM_ERR_RUNTIME 3 /* run-time guard tripped (NaN, particle left grid, dt) */
 #define EMPM_ERR_IO 4      /* file system or HDF5 failure, out of memory */
+#define EMPM_ERR_INTERRUPTED 6 /* a run asked to stop (empm run: SIGINT/SIGTERM) */
 
 /* info codes of empm_lme_basis */
 #define EMPM_LME_BAD_ARGUMENT (-1)

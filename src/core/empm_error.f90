@@ -14,12 +14,15 @@ module empm_error
   private
   public :: empm_error_t, empm_raise, empm_raise_error, empm_clear, empm_alloc_error
   public :: EMPM_OK, EMPM_ERR_USAGE, EMPM_ERR_INPUT, EMPM_ERR_RUNTIME, EMPM_ERR_IO
+  public :: EMPM_ERR_INTERRUPTED
 
   integer, parameter :: EMPM_OK = 0          !! success
   integer, parameter :: EMPM_ERR_USAGE = 1   !! bad command line or API misuse
   integer, parameter :: EMPM_ERR_INPUT = 2   !! invalid case file or input value
   integer, parameter :: EMPM_ERR_RUNTIME = 3 !! run-time guard tripped (NaN, particle left grid, dt)
   integer, parameter :: EMPM_ERR_IO = 4      !! file system or HDF5 failure (or out of memory)
+  integer, parameter :: EMPM_ERR_INTERRUPTED = 6 !! the run was asked to stop (a signal): a
+                                                 !! checkpoint and the results so far written
 
   !> An error status with a human-readable message and its location.
   type :: empm_error_t

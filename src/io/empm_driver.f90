@@ -1,18 +1,50 @@
 !> High-level driver: read a case file, run it, write the results. Used by the `empm run`
 !> command and callable from embedding codes.
 module empm_driver
-  use empm_error, only: empm_error_t, empm_raise_error, EMPM_OK
+  use, intrinsic :: iso_fortran_env, only: error_unit
+  use empm_error, only: empm_error_t, empm_raise_error, EMPM_OK, EMPM_ERR_INTERRUPTED
   use empm_case, only: empm_case_t
   use empm_input, only: empm_read_case
+  use empm_model, only: empm_model_t
   use empm_history, only: empm_history_t
-  use empm_solver, only: empm_solve, empm_run_stats_t
+  use empm_solver, only: empm_solve, empm_run_stats_t, empm_run_hook_t, empm_solver_state_t
   use empm_output, only: empm_write_results, empm_output_meta_t, empm_output_claim, &
     empm_output_release
+  use empm_checkpoint, only: empm_checkpoint_write, empm_checkpoint_read, empm_checkpoint_path
+  use empm_posix, only: empm_stop_signal
   implicit none
   private
   public :: empm_run_case
 
+  ! Checkpoints next to the results file, and the stop signal the program caught (if it
+  ! installed the handlers: `empm run` does, the library does not).
+  type, extends(empm_run_hook_t) :: driver_hook_t
+    character(len=:), allocatable :: path       ! OUT.ckpt.h5
+    character(len=:), allocatable :: prev       ! OUT.ckpt.prev.h5
+    character(len=:), allocatable :: case_text  ! the case file's text
+    logical :: written = .false.                ! a checkpoint was written
+  contains
+    procedure :: checkpoint => hook_checkpoint
+    procedure :: stop_requested => hook_stop
+  end type driver_hook_t
+
 contains
+
+  subroutine hook_checkpoint(self, model, hist, state, err)
+    class(driver_hook_t), intent(inout) :: self
+    type(empm_model_t), intent(in) :: model
+    type(empm_history_t), intent(in) :: hist
+    type(empm_solver_state_t), intent(in) :: state
+    type(empm_error_t), intent(out) :: err
+    call empm_checkpoint_write(self%path, self%prev, model, hist, state, self%case_text, err)
+    if (err%code == EMPM_OK) self%written = .true.
+  end subroutine hook_checkpoint
+
+  integer function hook_stop(self) result(sig)
+    class(driver_hook_t), intent(inout) :: self
+    associate (unused_ => self); end associate
+    sig = empm_stop_signal()
+  end function hook_stop
 
   !> Run the case in `path`, writing HDF5 to `output` (default: the case's &output file).
   !> Exit-status semantics when `err` is absent: 2 invalid input, 3 run-time guard, 4 I/O.
@@ -22,8 +54,14 @@ contains
   !> writing (status 4, the lock `OUT.lock`).
   !> The state at the start is stored as the first snapshot (t = 0, `/snapshots/000000`) even
   !> when the case's `snapshot_times` do not include it, unless `initial_snapshot` is false.
+  !> With the case's `checkpoint_every`/`checkpoint_seconds`, checkpoints go to OUT.ckpt.h5
+  !> (the previous one kept as OUT.ckpt.prev.h5); `restart` continues from one (a checkpoint
+  !> of this case file written by this version, else status 2 saying why), so that the results
+  !> equal the uninterrupted run's. A stop signal caught by the program (SIGINT, SIGTERM: see
+  !> empm_catch_stop_signals) ends the run after the current step with a checkpoint and the
+  !> results so far (marked incomplete), error code EMPM_ERR_INTERRUPTED.
   subroutine empm_run_case(path, output, progress, written, err, extra_groups, stats, &
-                           initial_snapshot)
+                           initial_snapshot, restart)
     character(len=*), intent(in) :: path                !! case file
     character(len=*), intent(in), optional :: output    !! output HDF5 path override
     logical, intent(in), optional :: progress           !! progress on stderr (default on; false
@@ -37,7 +75,13 @@ contains
                                                         !! energy balance (for a summary line)
     logical, intent(in), optional :: initial_snapshot   !! store the start as a snapshot
                                                         !! (default true)
+    character(len=*), intent(in), optional :: restart   !! checkpoint to continue from ('' or
+                                                        !! absent: start afresh)
     type(empm_case_t) :: cs
+    type(driver_hook_t) :: hook
+    type(empm_solver_state_t) :: sst
+    character(len=:), allocatable :: warning
+    logical :: resumed
     type(empm_history_t) :: hist
     type(empm_error_t) :: e, ew
     type(empm_output_meta_t) :: meta
@@ -63,7 +107,22 @@ contains
     if (add0) cs%run%snapshot_times = [cs%model%t, cs%run%snapshot_times]
     call hist%init(cs%model%grid%ndim, cs%probe_name, cs%probe_particle, 1024, &
                    size(cs%run%snapshot_times))
-    call empm_solve(cs%model, cs%integ, cs%run, hist, e, stats)
+    hook%path = empm_checkpoint_path(cs%output_file)
+    hook%prev = empm_checkpoint_path(cs%output_file, prev=.true.)
+    hook%case_text = cs%text
+    resumed = .false.
+    if (present(restart)) resumed = len_trim(restart) > 0
+    if (resumed) then
+      call empm_checkpoint_read(trim(restart), cs%model, hist, sst, cs%text, warning, e)
+      if (e%code /= EMPM_OK) then
+        call empm_output_release(cs%output_file)
+        call empm_raise_error(e, err); return
+      end if
+      if (len(warning) > 0 .and. cs%run%progress) write(error_unit, '(a)') 'empm: note: '//warning
+      call empm_solve(cs%model, cs%integ, cs%run, hist, e, stats, hook=hook, resume=sst)
+    else
+      call empm_solve(cs%model, cs%integ, cs%run, hist, e, stats, hook=hook)
+    end if
 
     meta%case_file = path; meta%case_text = cs%text
     meta%shape = cs%shape_name; meta%integrator = cs%scheme_name
@@ -77,7 +136,10 @@ contains
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then
       ! The guard's error, with its location fields; the message says where the state went.
-      if (ew%code == EMPM_OK) then
+      if (e%code == EMPM_ERR_INTERRUPTED .and. ew%code == EMPM_OK) then
+        e%message = e%message//' to '//hook%path//'; results so far written to '// &
+          cs%output_file//', marked incomplete; continue with --restart '//hook%path
+      else if (ew%code == EMPM_OK) then
         e%message = e%message//' (last good state written to '//cs%output_file// &
           ', marked incomplete)'
       else

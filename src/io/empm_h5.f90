@@ -7,12 +7,13 @@ module empm_h5
     h5acreate_f, h5awrite_f, h5aclose_f, h5tcopy_f, h5tset_size_f, h5tclose_f, &
     H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_NATIVE_CHARACTER, H5S_SCALAR_F, &
     h5open_f, h5fopen_f, h5fclose_f, h5fis_hdf5_f, H5F_ACC_RDONLY_F, h5lexists_f, h5dopen_f, &
-    h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5dread_f
+    h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5dread_f, &
+    h5aopen_f, h5aget_type_f, h5tget_size_f, h5aread_f, h5aexists_f
   use empm_kinds, only: wp
   implicit none
   private
   public :: hid_t, h5_group, h5_close_group, h5_write, h5_attr
-  public :: h5_open_read, h5_close_file, h5_exists, h5_dims, h5_read
+  public :: h5_open_read, h5_close_file, h5_exists, h5_dims, h5_read, h5_read_attr
 
   !> Write a dataset (real rank 1–2, integer rank 1).
   interface h5_write
@@ -28,6 +29,11 @@ module empm_h5
   interface h5_read
     module procedure read_r1, read_r2
   end interface h5_read
+
+  !> Read an attribute (a string).
+  interface h5_read_attr
+    module procedure read_attr_s
+  end interface h5_read_attr
 
 contains
 
@@ -282,5 +288,39 @@ contains
     call h5dclose_f(did, e(3))
     if (any(e /= 0)) ierr = 1
   end subroutine read_r2
+
+  !> Read the string attribute `name` of `loc` (a fixed-length string, as [[h5_attr]] writes
+  !> it); `ierr` set non-zero when it is missing or not a string.
+  subroutine read_attr_s(loc, name, s, ierr)
+    integer(hid_t), intent(in) :: loc                !! file, group or dataset
+    character(len=*), intent(in) :: name             !! attribute
+    character(len=:), allocatable, intent(out) :: s  !! its value
+    integer, intent(inout) :: ierr                   !! set non-zero on failure
+    integer(hid_t) :: aid, tid
+    integer(size_t) :: n
+    integer(hsize_t) :: dims(1)
+    logical :: there
+    integer :: e
+    s = ''
+    call h5aexists_f(loc, name, there, e)
+    if (e /= 0 .or. .not. there) then
+      ierr = 1; return
+    end if
+    call h5aopen_f(loc, name, aid, e)
+    if (e /= 0) then
+      ierr = 1; return
+    end if
+    call h5aget_type_f(aid, tid, e)
+    if (e == 0) call h5tget_size_f(tid, n, e)
+    if (e == 0 .and. n > 0 .and. n < 100000000_size_t) then
+      deallocate(s); allocate(character(len=int(n)) :: s)
+      dims = 1
+      call h5aread_f(aid, tid, s, dims, e)
+    else
+      e = 1
+    end if
+    if (e /= 0) ierr = 1
+    call h5tclose_f(tid, e); call h5aclose_f(aid, e)
+  end subroutine read_attr_s
 
 end module empm_h5

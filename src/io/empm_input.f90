@@ -182,7 +182,13 @@ contains
           '(and at t_end)', default='1', lo=1.0_wp), &
         empm_param('snapshot_times', PARAM_REAL, 's', 'increasing times in [0, t_end] at '// &
           'which the particle state is stored', count=MAXSNAP, lo=0.0_wp, hi=LMAX, &
-          optional=.true.)]
+          optional=.true.), &
+        empm_param('checkpoint_every', PARAM_INT, '-', 'write a restart checkpoint every n '// &
+          'steps (OUT.ckpt.h5, the previous one kept as OUT.ckpt.prev.h5; docs/output.md); '// &
+          '0: none', default='0', lo=0.0_wp), &
+        empm_param('checkpoint_seconds', PARAM_REAL, 's', 'write a restart checkpoint when '// &
+          'this much wall-clock time has passed since the last one (with or without '// &
+          'checkpoint_every); 0: none', default='0', lo=0.0_wp, hi=LMAX)]
     case default
       allocate(p(0))
     end select
@@ -1106,8 +1112,8 @@ contains
     type(empm_param_t), allocatable :: p(:)
     type(empm_group_t) :: g
     character(len=:), allocatable :: file
-    integer :: history_every, n, i
-    real(wp) :: snapshot_times(MAXSNAP)
+    integer :: history_every, n, i, ckpt_every
+    real(wp) :: snapshot_times(MAXSNAP), ckpt_seconds
     allocate(p, source=empm_input_group_params('output'))
     call group_or_empty(path, gs, 'output', g)
     call g%check_keys(p, e)
@@ -1115,7 +1121,12 @@ contains
     call g%get(p(1), file, e)
     call g%get(p(2), history_every, e)
     call g%get(p(3), snapshot_times, n, e)
+    ckpt_every = 0; ckpt_seconds = 0.0_wp
+    call g%get(p(4), ckpt_every, e)
+    call g%get(p(5), ckpt_seconds, e)
     if (e%code /= EMPM_OK) return
+    cs%run%checkpoint_every = ckpt_every
+    cs%run%checkpoint_seconds = ckpt_seconds
     do i = 1, n
       if (snapshot_times(i) > cs%run%t_end .or. &
           (i > 1 .and. snapshot_times(max(i - 1, 1)) >= snapshot_times(i))) then

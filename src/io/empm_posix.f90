@@ -5,11 +5,11 @@
 !> failed write, reported, not a killed process).
 module empm_posix
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_funptr, &
-    c_intptr_t, c_f_pointer, c_associated, c_int16_t
+    c_intptr_t, c_f_pointer, c_associated, c_int16_t, c_funloc
   implicit none
   private
   public :: empm_getpid, empm_process_alive, empm_path_kind, empm_errno, empm_errno_text, &
-            empm_ignore_sigxfsz
+            empm_ignore_sigxfsz, empm_catch_stop_signals, empm_stop_signal
   public :: PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY, PATH_OTHER
 
   integer, parameter :: PATH_MISSING = 0   !! nothing at the path (or it cannot be examined)
@@ -54,6 +54,10 @@ module empm_posix
   ! Linux constants (the same on every architecture gfortran targets there except MIPS/SPARC,
   ! which empm does not support).
   integer(c_int), parameter :: AT_FDCWD = -100, STATX_TYPE = 1, SIGXFSZ = 25
+  integer(c_int), parameter :: SIGINT = 2, SIGTERM = 15
+
+  !> The stop signal caught (0: none). Written only by the handler, read by the time loop.
+  integer(c_int), volatile, save :: caught = 0
   integer, parameter :: S_IFMT = int(o'170000'), S_IFREG = int(o'100000'), &
                         S_IFDIR = int(o'040000')
 
@@ -133,6 +137,29 @@ contains
     ign = transfer(1_c_intptr_t, ign)  ! SIG_IGN
     old = c_signal(SIGXFSZ, ign)
   end subroutine empm_ignore_sigxfsz
+
+  !> Catch SIGINT and SIGTERM: the handler only records the signal (async-signal-safe), and
+  !> the time loop, polling [[empm_stop_signal]] once per step, writes a checkpoint and the
+  !> results so far and stops. A second signal of the same kind has its default effect
+  !> (the handler restores it). For programs (`empm run`), not for the library: a host
+  !> program owns its signals.
+  subroutine empm_catch_stop_signals()
+    type(c_funptr) :: old
+    old = c_signal(SIGINT, c_funloc(on_stop_signal))
+    old = c_signal(SIGTERM, c_funloc(on_stop_signal))
+  end subroutine empm_catch_stop_signals
+
+  !> The stop signal caught so far (SIGINT = 2, SIGTERM = 15), 0 when none.
+  integer function empm_stop_signal() result(sig)
+    sig = int(caught)
+  end function empm_stop_signal
+
+  subroutine on_stop_signal(sig) bind(C)
+    integer(c_int), value :: sig
+    type(c_funptr) :: old
+    caught = sig
+    old = c_signal(sig, transfer(0_c_intptr_t, old))  ! SIG_DFL
+  end subroutine on_stop_signal
 
   pure function itoa(i) result(s)
     integer, intent(in) :: i

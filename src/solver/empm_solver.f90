@@ -5,7 +5,7 @@ module empm_solver
   use empm_kinds, only: wp
   use empm_params, only: empm_param_t, empm_param, PARAM_REAL, PARAM_INT
   use empm_error, only: empm_error_t, empm_raise, empm_raise_error, empm_alloc_error, &
-                        EMPM_ERR_RUNTIME, EMPM_ERR_USAGE
+                        EMPM_ERR_RUNTIME, EMPM_ERR_USAGE, EMPM_ERR_INTERRUPTED
   use empm_strings, only: str, join
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK, STEP_SHAPE_FAILED
   use empm_integrator, only: empm_integrator_t
@@ -18,6 +18,7 @@ module empm_solver
   public :: empm_run_params
   public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies, empm_check_guards
   public :: empm_run_stats_t, empm_run_summary
+  public :: empm_run_hook_t, empm_solver_state_t
 
   !> How to run: end time, time step control, output sampling.
   type :: empm_run_config_t
@@ -30,7 +31,45 @@ module empm_solver
     logical :: progress = .true.               !! progress on stderr: a line updated in place
                                                !! on a terminal, plain lines (every 10 % of
                                                !! t_end or 10 s) otherwise
+    integer :: checkpoint_every = 0            !! checkpoint every n steps (0: never), through
+                                               !! the hook given to [[empm_solve]]
+    real(wp) :: checkpoint_seconds = 0.0_wp    !! checkpoint after this much wall time [s]
+                                               !! (0: never)
   end type empm_run_config_t
+
+  !> The time loop's own progress: what a checkpoint stores besides the model and the
+  !> histories, and what [[empm_solve]] continues from on a restart.
+  type :: empm_solver_state_t
+    integer :: isnap = 1                      !! next snapshot time to store
+    integer :: steps = 0                      !! steps taken since the run's start
+    real(wp) :: dt_min = huge(1.0_wp)         !! smallest time step so far [s]
+    real(wp) :: dt_max = 0.0_wp               !! largest time step so far [s]
+    real(wp) :: t_start = 0.0_wp              !! time at the run's start [s]
+    real(wp) :: energy_initial = 0.0_wp       !! total energy at the run's start [J]
+    real(wp) :: work_gravity = 0.0_wp         !! work of a time-varying gravity so far [J]
+  end type empm_solver_state_t
+
+  !> What the time loop calls out to, once per step: a checkpoint when one is due, and a
+  !> request to stop (e.g. a signal caught by the program). Extended by the driver, which
+  !> knows where and how to write (the solver writes no files).
+  type, abstract :: empm_run_hook_t
+  contains
+    procedure(hook_checkpoint), deferred :: checkpoint
+    procedure :: stop_requested => hook_stop_requested
+  end type empm_run_hook_t
+
+  abstract interface
+    !> Write a checkpoint of the state after a completed step.
+    subroutine hook_checkpoint(self, model, hist, state, err)
+      import :: empm_run_hook_t, empm_model_t, empm_history_t, empm_solver_state_t, &
+        empm_error_t
+      class(empm_run_hook_t), intent(inout) :: self     !! hook
+      type(empm_model_t), intent(in) :: model           !! the state (last step completed)
+      type(empm_history_t), intent(in) :: hist          !! histories and snapshots so far
+      type(empm_solver_state_t), intent(in) :: state    !! the loop's progress
+      type(empm_error_t), intent(out) :: err            !! error (code 0 when written)
+    end subroutine hook_checkpoint
+  end interface
 
   !> What a run did, for an end-of-run summary ([[empm_run_summary]]).
   type :: empm_run_stats_t
@@ -52,6 +91,14 @@ module empm_solver
   end type empm_run_stats_t
 
 contains
+
+  !> Default: no stop is ever requested. Returns a signal number (> 0) when the run must stop
+  !> after the current step, writing a checkpoint first.
+  integer function hook_stop_requested(self) result(sig)
+    class(empm_run_hook_t), intent(inout) :: self !! hook
+    associate (unused_ => self); end associate
+    sig = 0
+  end function hook_stop_requested
 
   !> The run controls of the `&integrator` group (t_end, cfl, dt, max_steps), declared here
   !> where they are used; the case reader reads them, the scheme its own keys.
@@ -110,7 +157,16 @@ contains
   !> Run `model` with `integ` until `cfg%t_end`. Records energies, probes and snapshots in
   !> `hist`. On a tripped guard the model is restored to the last good state and the error
   !> (code EMPM_ERR_RUNTIME) names the step, the particle or node and the quantity.
-  subroutine empm_solve(model, integ, cfg, hist, err, stats)
+  !>
+  !> With `hook`, a checkpoint is asked of it every `cfg%checkpoint_every` steps and every
+  !> `cfg%checkpoint_seconds` of wall time, and its stop request is polled once per step: on a
+  !> request the loop writes a checkpoint and returns EMPM_ERR_INTERRUPTED (the model holds the
+  !> last completed step). With `resume` (a restart), `model` and `hist` already hold a
+  !> checkpoint's state: the integrator's start-up is not redone (its work arrays are set up,
+  !> then the particles and the traction state are put back as they were), no first sample
+  !> is taken, and the loop continues from `resume`; the run is then bitwise the uninterrupted
+  !> one when the number of threads is the same (the P2G sums follow the thread chunks).
+  subroutine empm_solve(model, integ, cfg, hist, err, stats, hook, resume)
     type(empm_model_t), intent(inout) :: model                !! simulation (set up)
     class(empm_integrator_t), intent(inout) :: integ          !! time integrator
     type(empm_run_config_t), intent(in) :: cfg                !! run controls
@@ -119,7 +175,14 @@ contains
     type(empm_run_stats_t), intent(out), optional :: stats    !! steps, time steps, wall time and
                                                               !! energies of the run (also when
                                                               !! a guard stopped it)
+    class(empm_run_hook_t), intent(inout), optional :: hook   !! checkpoints and stop requests
+    type(empm_solver_state_t), intent(in), optional :: resume !! continue a restored run
     type(empm_particles_t) :: good
+    type(empm_solver_state_t) :: sst
+    real(wp), allocatable :: tlam(:,:,:)
+    real(wp) :: residual0
+    integer(int64) :: clock_ckpt
+    integer :: sig, k
     type(empm_step_status_t) :: stat
     real(wp), allocatable :: psi(:)
     real(wp) :: dt, dt_stable, ekin, estr, egrav, t_good, t_next_snap
@@ -140,8 +203,15 @@ contains
       call empm_raise(EMPM_ERR_USAGE, 'empm_solve: t_end must exceed the current time', err)
       return
     end if
-    call integ%prepare(model, e)
-    if (e%code == 0) call good%alloc(model%grid%ndim, model%pts%np, model%pts%nstate, e)
+    call good%alloc(model%grid%ndim, model%pts%np, model%pts%nstate, e)
+    if (e%code == 0 .and. present(resume)) then
+      ! The integrator's start-up changes the particles (initial accelerations, LME
+      ! multipliers) and resets the traction state: keep the restored ones aside.
+      call good%copy_state_from(model%pts)
+      call save_tractions()
+      residual0 = model%residual
+    end if
+    if (e%code == 0) call integ%prepare(model, e)
     if (e%code == 0) then
       allocate(psi(model%pts%np), stat=astat, errmsg=amsg)
       if (astat /= 0) e = empm_alloc_error('energy scratch', 8_int64 * model%pts%np, amsg)
@@ -151,18 +221,28 @@ contains
     end if
     nsnap = 0
     if (allocated(cfg%snapshot_times)) nsnap = size(cfg%snapshot_times)
-    isnap = 1
-    call empm_energies(model, psi, ekin, estr, egrav)
-    call hist%add_sample(model%t, ekin, estr, egrav, model%pts, model)
-    st%t_start = model%t; st%energy_initial = ekin + estr + egrav
-    st%dt_min = huge(1.0_wp)
-    call skip_past_snapshots()
+    if (present(resume)) then
+      call model%pts%copy_state_from(good)
+      call restore_tractions()
+      model%residual = residual0
+      isnap = resume%isnap
+      st%steps = resume%steps; st%dt_min = resume%dt_min; st%dt_max = resume%dt_max
+      st%t_start = resume%t_start; st%energy_initial = resume%energy_initial
+      st%work_gravity = resume%work_gravity
+    else
+      isnap = 1
+      call empm_energies(model, psi, ekin, estr, egrav)
+      call hist%add_sample(model%t, ekin, estr, egrav, model%pts, model)
+      st%t_start = model%t; st%energy_initial = ekin + estr + egrav
+      st%dt_min = huge(1.0_wp)
+      call skip_past_snapshots()
+    end if
     show = cfg%progress
     tty = .false.
     if (show) tty = stderr_is_terminal()
     ! Plain lines (logs, pipes) are written when t passes the next tenth of the run.
     t_report = model%t + 0.1_wp * (cfg%t_end - model%t)
-    call system_clock(clock0, rate); clock_last = clock0
+    call system_clock(clock0, rate); clock_last = clock0; clock_ckpt = clock0
 
     do while (model%t < cfg%t_end * (1.0_wp - 1.0e-12_wp))
       if (model%step >= cfg%max_steps) then
@@ -207,11 +287,88 @@ contains
       end if
       call skip_past_snapshots()
       if (show) call progress()
+      if (present(hook)) then
+        sig = hook%stop_requested()
+        if (checkpoint_due() .or. sig /= 0) then
+          call checkpoint(e)
+          if (e%code /= 0) then
+            if (show .and. tty) write(error_unit, '(a)') ''
+            call finish_stats(); call empm_raise_error(e, err); return
+          end if
+        end if
+        if (sig /= 0) then
+          if (show .and. tty) write(error_unit, '(a)') ''
+          call finish_stats()
+          call empm_raise(EMPM_ERR_INTERRUPTED, 'stopped by '//signal_name(sig)// &
+            ' after step '//str(model%step)//' at t = '//str(model%t)// &
+            ' s: checkpoint written', err)
+          return
+        end if
+      end if
     end do
     if (show .and. tty) write(error_unit, '(a)') ''
     call finish_stats()
 
   contains
+
+    function signal_name(k) result(name)
+      integer, intent(in) :: k
+      character(len=:), allocatable :: name
+      select case (k)
+      case (2); name = 'SIGINT'
+      case (15); name = 'SIGTERM'
+      case default; name = 'signal '//str(k)
+      end select
+    end function signal_name
+
+    ! A checkpoint is due every checkpoint_every steps and once checkpoint_seconds of wall
+    ! time have passed since the last one (one clock read per step only when that is set).
+    logical function checkpoint_due() result(due)
+      integer(int64) :: c
+      due = .false.
+      if (cfg%checkpoint_every > 0) due = mod(model%step, cfg%checkpoint_every) == 0
+      if (.not. due .and. cfg%checkpoint_seconds > 0.0_wp) then
+        call system_clock(c)
+        due = real(c - clock_ckpt, wp) / real(rate, wp) >= cfg%checkpoint_seconds
+      end if
+    end function checkpoint_due
+
+    subroutine checkpoint(ec)
+      type(empm_error_t), intent(out) :: ec
+      sst%isnap = isnap; sst%steps = st%steps; sst%dt_min = st%dt_min; sst%dt_max = st%dt_max
+      sst%t_start = st%t_start; sst%energy_initial = st%energy_initial
+      sst%work_gravity = st%work_gravity
+      call hook%checkpoint(model, hist, sst, ec)
+      call system_clock(clock_ckpt)
+    end subroutine checkpoint
+
+    ! The surface tractions' shape-function state (LME multipliers at the face centres),
+    ! which the integrator's preparation resets.
+    subroutine save_tractions()
+      integer :: n
+      if (model%loads%ntraction() == 0) return
+      n = 0
+      do k = 1, size(model%loads%tractions)
+        if (allocated(model%loads%tractions(k)%lam)) &
+          n = max(n, size(model%loads%tractions(k)%lam, 2))
+      end do
+      allocate(tlam(model%grid%ndim, n, size(model%loads%tractions)))
+      tlam = 0.0_wp
+      do k = 1, size(model%loads%tractions)
+        associate (tr => model%loads%tractions(k))
+          if (allocated(tr%lam)) tlam(:, 1:size(tr%lam, 2), k) = tr%lam
+        end associate
+      end do
+    end subroutine save_tractions
+
+    subroutine restore_tractions()
+      if (.not. allocated(tlam)) return
+      do k = 1, size(model%loads%tractions)
+        associate (tr => model%loads%tractions(k))
+          if (allocated(tr%lam)) tr%lam = tlam(:, 1:size(tr%lam, 2), k)
+        end associate
+      end do
+    end subroutine restore_tractions
 
     ! The potential −Σ m g(t)·x changes with g(t) too: the ramp's work, so that the energy
     ! balance of the summary can subtract it. Diagnostics only (the state is not touched).

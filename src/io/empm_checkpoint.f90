@@ -1,0 +1,485 @@
+!> Restart checkpoints: everything a run needs to continue bitwise as if it had not stopped
+!> (layout in docs/output.md, "Checkpoints").
+!>
+!> A checkpoint holds every particle array (the integrators and the LME warm start keep their
+!> memory there), the time, step and residual, the surface tractions' shape-function state,
+!> the time loop's progress ([[empm_solver_state_t]]), and the histories and snapshots so far,
+!> so that the results file written at the end of a restarted run equals the uninterrupted
+!> run's. It also records the program version, the full text of the case file and the number of
+!> threads. A checkpoint is written under a unique partial name and renamed: `OUT.ckpt.h5`, the
+!> previous one kept as `OUT.ckpt.prev.h5` (the last two). Reading one refuses, with an input
+!> error saying why, a file that is not an empm checkpoint, one written by another version, for
+!> another case file (first differing line named) or for another particle set.
+module empm_checkpoint
+  use hdf5, only: hid_t, h5open_f, h5fcreate_f, h5fclose_f, H5F_ACC_EXCL_F, h5eset_auto_f
+  use empm_kinds, only: wp
+  use empm_strings, only: str
+  use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO, EMPM_ERR_INPUT
+  use empm_h5, only: h5_group, h5_close_group, h5_write, h5_attr, h5_open_read, &
+    h5_close_file, h5_exists, h5_dims, h5_read, h5_read_attr
+  use empm_files, only: empm_rename, empm_remove
+  use empm_posix, only: empm_errno, empm_errno_text, empm_path_kind, PATH_REGULAR
+  use empm_version_info, only: empm_version
+  use empm_parallel, only: empm_max_threads
+  use empm_model, only: empm_model_t
+  use empm_history, only: empm_history_t
+  use empm_solver, only: empm_solver_state_t
+  use empm_output, only: empm_partial_name
+  implicit none
+  private
+  public :: empm_checkpoint_write, empm_checkpoint_read, empm_checkpoint_path
+
+  character(len=*), parameter :: FORMAT_NAME = 'empm checkpoint'
+  integer, parameter :: FORMAT_VERSION = 1
+
+contains
+
+  !> The checkpoint file of the results file `output`: `OUT.h5` -> `OUT.ckpt.h5` (`prev`:
+  !> `OUT.ckpt.prev.h5`, the one before).
+  pure function empm_checkpoint_path(output, prev) result(path)
+    character(len=*), intent(in) :: output     !! results file
+    logical, intent(in), optional :: prev      !! the previous checkpoint's name
+    character(len=:), allocatable :: path      !! checkpoint file
+    character(len=:), allocatable :: stem
+    integer :: n
+    n = len_trim(output)
+    stem = output(1:n)
+    if (n > 3) then
+      if (output(n - 2:n) == '.h5') stem = output(1:n - 3)
+    end if
+    path = stem//'.ckpt.h5'
+    if (present(prev)) then
+      if (prev) path = stem//'.ckpt.prev.h5'
+    end if
+  end function empm_checkpoint_path
+
+  !> Write a checkpoint of `model`, `hist` and `state` to `path`, atomically; an existing
+  !> `path` becomes the previous checkpoint (`prev`), replacing the one before.
+  subroutine empm_checkpoint_write(path, prev, model, hist, state, case_text, err)
+    character(len=*), intent(in) :: path               !! checkpoint file
+    character(len=*), intent(in) :: prev               !! where the previous one goes
+    type(empm_model_t), intent(in) :: model            !! the state after a completed step
+    type(empm_history_t), intent(in) :: hist           !! histories and snapshots so far
+    type(empm_solver_state_t), intent(in) :: state     !! the time loop's progress
+    character(len=*), intent(in) :: case_text          !! full text of the case file
+    type(empm_error_t), intent(out) :: err             !! error (EMPM_ERR_IO), if any
+    integer(hid_t) :: fid, g, gs, gk
+    character(len=:), allocatable :: tmp
+    integer :: e, ierr, k, n, nd, oserr, info
+    tmp = empm_partial_name(path)
+    call h5open_f(e)
+    call h5eset_auto_f(0, e)
+    call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e)
+    if (e /= 0) then
+      call empm_raise(EMPM_ERR_IO, path//': cannot create the checkpoint '//tmp//': '// &
+        empm_errno_text(empm_errno()), err); return
+    end if
+    ierr = 0
+    n = model%pts%np; nd = model%grid%ndim
+    call h5_attr(fid, 'format', FORMAT_NAME, ierr)
+    call h5_attr(fid, 'format_version', FORMAT_VERSION, ierr)
+    call h5_attr(fid, 'empm_version', empm_version(), ierr)
+    call h5_attr(fid, 'case_text', case_text, ierr)
+    call h5_attr(fid, 'threads', empm_max_threads(), ierr)
+    call h5_attr(fid, 'particles', n, ierr)
+    call h5_attr(fid, 'ndim', nd, ierr)
+    call h5_attr(fid, 'nstate', model%pts%nstate, ierr)
+
+    call h5_group(fid, 'model', g, ierr)
+    call h5_write(g, 'scalars', [model%t, real(model%step, wp), model%residual], ierr)
+    call h5_close_group(g, ierr)
+
+    call h5_group(fid, 'particles', g, ierr)
+    associate (p => model%pts)
+      call h5_write(g, 'x', p%x(:, 1:n), ierr); call h5_write(g, 'x0', p%x0(:, 1:n), ierr)
+      call h5_write(g, 'v', p%v(:, 1:n), ierr); call h5_write(g, 'a', p%a(:, 1:n), ierr)
+      call h5_write(g, 'm', p%m(1:n), ierr); call h5_write(g, 'vol', p%vol(1:n), ierr)
+      call h5_write(g, 'vol0', p%vol0(1:n), ierr); call h5_write(g, 'rho', p%rho(1:n), ierr)
+      call h5_write(g, 'stress', p%stress(:, 1:n), ierr)
+      call h5_write(g, 'strain', p%strain(:, 1:n), ierr)
+      call h5_write(g, 'F', reshape(p%F(:, :, 1:n), [9, n]), ierr)
+      call h5_write(g, 'lp', p%lp(:, 1:n), ierr)
+      call h5_write(g, 'lam', p%lam(:, 1:n), ierr)
+      call h5_write(g, 'lam_old', p%lam_old(:, 1:n), ierr)
+      call h5_write(g, 'mat', real(p%mat(1:n), wp), ierr)
+      if (p%nstate > 0) call h5_write(g, 'state', p%state(:, 1:n), ierr)
+    end associate
+    call h5_close_group(g, ierr)
+
+    call h5_group(fid, 'tractions', g, ierr)
+    if (model%loads%ntraction() > 0) then
+      do k = 1, size(model%loads%tractions)
+        call h5_group(g, str(k), gk, ierr)
+        associate (tr => model%loads%tractions(k))
+          if (allocated(tr%lam)) then
+            if (size(tr%lam) > 0) call h5_write(gk, 'lam', tr%lam, ierr)
+          end if
+        end associate
+        call h5_close_group(gk, ierr)
+      end do
+    end if
+    call h5_close_group(g, ierr)
+
+    call h5_group(fid, 'solver', g, ierr)
+    call h5_write(g, 'scalars', [real(state%isnap, wp), real(state%steps, wp), state%dt_min, &
+      state%dt_max, state%t_start, state%energy_initial, state%work_gravity], ierr)
+    call h5_close_group(g, ierr)
+
+    call h5_group(fid, 'history', g, ierr)
+    call h5_write(g, 'counts', [real(hist%nt, wp), real(hist%nprobe, wp), &
+      real(hist%nsnap, wp), merge(1.0_wp, 0.0_wp, hist%tracked), real(hist%nset, wp)], ierr)
+    if (hist%nt > 0) then
+      call h5_write(g, 't', hist%t(1:hist%nt), ierr)
+      call h5_write(g, 'kinetic', hist%kinetic(1:hist%nt), ierr)
+      call h5_write(g, 'strain', hist%strain(1:hist%nt), ierr)
+      call h5_write(g, 'gravity', hist%gravity(1:hist%nt), ierr)
+      if (hist%nprobe > 0) then
+        call h5_write(g, 'px', reshape(hist%px(:, :, 1:hist%nt), &
+          [size(hist%px, 1) * hist%nprobe, hist%nt]), ierr)
+        call h5_write(g, 'pv', reshape(hist%pv(:, :, 1:hist%nt), &
+          [size(hist%pv, 1) * hist%nprobe, hist%nt]), ierr)
+        call h5_write(g, 'ps', reshape(hist%ps(:, :, 1:hist%nt), [6 * hist%nprobe, hist%nt]), &
+          ierr)
+      end if
+      if (hist%tracked) then
+        call h5_write(g, 'residual', hist%residual(1:hist%nt), ierr)
+        if (hist%nset > 0) then
+          call h5_write(g, 'reaction', reshape(hist%reaction(:, :, 1:hist%nt), &
+            [size(hist%reaction, 1) * hist%nset, hist%nt]), ierr)
+          call h5_write(g, 'set_disp', reshape(hist%set_disp(:, :, 1:hist%nt), &
+            [size(hist%set_disp, 1) * hist%nset, hist%nt]), ierr)
+        end if
+      end if
+    end if
+    call h5_group(g, 'snapshots', gs, ierr)
+    do k = 1, hist%nsnap
+      call h5_group(gs, str(k), gk, ierr)
+      associate (sn => hist%snap(k))
+        call h5_write(gk, 'scalars', [sn%t, real(sn%step, wp)], ierr)
+        call h5_write(gk, 'x', sn%x, ierr); call h5_write(gk, 'v', sn%v, ierr)
+        call h5_write(gk, 'stress', sn%stress, ierr); call h5_write(gk, 'strain', sn%strain, ierr)
+        call h5_write(gk, 'm', sn%m, ierr); call h5_write(gk, 'vol', sn%vol, ierr)
+        call h5_write(gk, 'rho', sn%rho, ierr)
+        if (size(sn%state) > 0) call h5_write(gk, 'state', sn%state, ierr)
+      end associate
+      call h5_close_group(gk, ierr)
+    end do
+    call h5_close_group(gs, ierr)
+    call h5_close_group(g, ierr)
+
+    oserr = 0
+    if (ierr /= 0) oserr = empm_errno()
+    call h5fclose_f(fid, e)
+    if (e /= 0) then
+      ierr = e
+      if (oserr == 0) oserr = empm_errno()
+    end if
+    if (ierr /= 0) then
+      info = empm_remove(tmp)
+      call empm_raise(EMPM_ERR_IO, path//': writing the checkpoint failed: '//reason(oserr), &
+        err); return
+    end if
+    ! Keep the last two: the current one becomes the previous, then the new one takes its
+    ! place (a crash between the two renames leaves the previous one to restart from).
+    if (empm_path_kind(path) == PATH_REGULAR) then
+      if (empm_rename(path, prev) /= 0) then
+        oserr = empm_errno(); info = empm_remove(tmp)
+        call empm_raise(EMPM_ERR_IO, path//': cannot keep it as '//prev//': '// &
+          reason(oserr), err); return
+      end if
+    end if
+    if (empm_rename(tmp, path) /= 0) then
+      oserr = empm_errno(); info = empm_remove(tmp)
+      call empm_raise(EMPM_ERR_IO, path//': cannot rename '//tmp//' to it: '//reason(oserr), &
+        err); return
+    end if
+  contains
+    function reason(code) result(r)
+      integer, intent(in) :: code
+      character(len=:), allocatable :: r
+      if (code > 0) then
+        r = empm_errno_text(code)
+      else
+        r = 'the HDF5 library reports an error'
+      end if
+    end function reason
+  end subroutine empm_checkpoint_write
+
+  !> Restore `model` (set up from the same case file), `hist` (initialised for it) and `state`
+  !> from the checkpoint `path`. Refused (EMPM_ERR_INPUT, saying why) when `path` is missing or
+  !> not an empm checkpoint, or was written by another version of empm, for another case file
+  !> (`case_text` differs) or for another particle set. `warning` is '' or a note (another
+  !> number of threads: the run continues, but not bitwise).
+  subroutine empm_checkpoint_read(path, model, hist, state, case_text, warning, err)
+    character(len=*), intent(in) :: path               !! checkpoint file
+    type(empm_model_t), intent(inout) :: model         !! model to restore into
+    type(empm_history_t), intent(inout) :: hist        !! histories to restore into
+    type(empm_solver_state_t), intent(out) :: state    !! the time loop's progress
+    character(len=*), intent(in) :: case_text          !! full text of this run's case file
+    character(len=:), allocatable, intent(out) :: warning !! '' or a note for the user
+    type(empm_error_t), intent(out) :: err             !! error, if any
+    integer(hid_t) :: fid, g, gs, gk
+    character(len=:), allocatable :: s
+    real(wp), allocatable :: r1(:), r2(:,:)
+    real(wp) :: sc(7), cnt(5)
+    integer :: ierr, e, n, nd, k, nt, np, ns, threads
+    warning = ''
+    ! Failures are ours to report, once: not HDF5's error stacks (a damaged file).
+    call h5open_f(e)
+    call h5eset_auto_f(0, e)
+    call h5_open_read(path, fid, ierr)
+    select case (ierr)
+    case (1)
+      call refuse('no such file'); return
+    case (2)
+      call refuse('not an HDF5 file'); return
+    case (3)
+      call refuse('cannot be opened'); return
+    end select
+    ierr = 0
+    call h5_read_attr(fid, 'format', s, ierr)
+    if (ierr /= 0 .or. s /= FORMAT_NAME) then
+      call refuse('not an empm checkpoint (no "format" attribute saying so)'); return
+    end if
+    call h5_read_attr(fid, 'empm_version', s, ierr)
+    if (ierr /= 0) then
+      call refuse('it has no empm_version attribute'); return
+    end if
+    if (s /= empm_version()) then
+      call refuse('written by empm '//s//', this is empm '//empm_version()// &
+        ' (a checkpoint restarts only with the version that wrote it)'); return
+    end if
+    call h5_read_attr(fid, 'case_text', s, ierr)
+    if (ierr /= 0) then
+      call refuse('it has no case_text attribute'); return
+    end if
+    if (s /= case_text) then
+      call refuse('written for another case file: '//first_difference(s, case_text)); return
+    end if
+    np = int_attr('particles'); nd = int_attr('ndim'); ns = int_attr('nstate')
+    threads = int_attr('threads')
+    if (ierr /= 0) then
+      call refuse('its attributes particles, ndim, nstate, threads are incomplete'); return
+    end if
+    if (np /= model%pts%np .or. nd /= model%grid%ndim .or. ns /= model%pts%nstate) then
+      call refuse('it holds '//str(np)//' particles in '//str(nd)//'D with '//str(ns)// &
+        ' state variables, the case '//str(model%pts%np)//' in '//str(model%grid%ndim)// &
+        'D with '//str(model%pts%nstate)); return
+    end if
+    if (threads /= empm_max_threads()) warning = 'the checkpoint was written with '// &
+      str(threads)//' threads, this run uses '//str(empm_max_threads())//': it continues, '// &
+      'but not bitwise as the uninterrupted run (the sums over particles follow the threads)'
+    n = np
+
+    ! Everything below exists in a file written by empm_checkpoint_write of this version.
+    call open_group(fid, 'model', g)
+    allocate(r1(3)); call h5_read(g, 'scalars', r1, ierr)
+    model%t = r1(1); model%step = nint(r1(2)); model%residual = r1(3)
+    call h5_close_group(g, ierr)
+
+    call open_group(fid, 'particles', g)
+    associate (p => model%pts)
+      call h5_read(g, 'x', p%x(:, 1:n), ierr); call h5_read(g, 'x0', p%x0(:, 1:n), ierr)
+      call h5_read(g, 'v', p%v(:, 1:n), ierr); call h5_read(g, 'a', p%a(:, 1:n), ierr)
+      call h5_read(g, 'm', p%m(1:n), ierr); call h5_read(g, 'vol', p%vol(1:n), ierr)
+      call h5_read(g, 'vol0', p%vol0(1:n), ierr); call h5_read(g, 'rho', p%rho(1:n), ierr)
+      call h5_read(g, 'stress', p%stress(:, 1:n), ierr)
+      call h5_read(g, 'strain', p%strain(:, 1:n), ierr)
+      allocate(r2(9, n)); call h5_read(g, 'F', r2, ierr)
+      p%F(:, :, 1:n) = reshape(r2, [3, 3, n]); deallocate(r2)
+      call h5_read(g, 'lp', p%lp(:, 1:n), ierr)
+      call h5_read(g, 'lam', p%lam(:, 1:n), ierr)
+      call h5_read(g, 'lam_old', p%lam_old(:, 1:n), ierr)
+      deallocate(r1); allocate(r1(n)); call h5_read(g, 'mat', r1, ierr)
+      p%mat(1:n) = nint(r1)
+      if (p%nstate > 0) call h5_read(g, 'state', p%state(:, 1:n), ierr)
+    end associate
+    call h5_close_group(g, ierr)
+
+    call open_group(fid, 'tractions', g)
+    if (model%loads%ntraction() > 0) then
+      do k = 1, size(model%loads%tractions)
+        associate (tr => model%loads%tractions(k))
+          if (allocated(tr%lam)) deallocate(tr%lam)
+          allocate(tr%lam(nd, size(tr%part)))
+          tr%lam = 0.0_wp
+          call open_group(g, str(k), gk)
+          if (size(tr%lam) > 0) call h5_read(gk, 'lam', tr%lam, ierr)
+          call h5_close_group(gk, ierr)
+        end associate
+      end do
+    end if
+    call h5_close_group(g, ierr)
+
+    call open_group(fid, 'solver', g)
+    call h5_read(g, 'scalars', sc, ierr)
+    state%isnap = nint(sc(1)); state%steps = nint(sc(2)); state%dt_min = sc(3)
+    state%dt_max = sc(4); state%t_start = sc(5); state%energy_initial = sc(6)
+    state%work_gravity = sc(7)
+    call h5_close_group(g, ierr)
+
+    call open_group(fid, 'history', g)
+    call h5_read(g, 'counts', cnt, ierr)
+    nt = nint(cnt(1))
+    if (nint(cnt(2)) /= hist%nprobe .or. nint(cnt(3)) > size(hist%snap)) then
+      call refuse('its probes or snapshots do not match the case file'); return
+    end if
+    call restore_history()
+    call h5_close_group(g, ierr)
+    call h5_close_file(fid, ierr)
+    if (ierr /= 0) then
+      call empm_raise(EMPM_ERR_IO, path//': reading the checkpoint failed (a damaged file?)', &
+        err)
+    end if
+
+  contains
+
+    subroutine refuse(why)
+      character(len=*), intent(in) :: why
+      integer :: ie
+      if (fid >= 0) call h5_close_file(fid, ie)
+      call empm_raise(EMPM_ERR_INPUT, path//': cannot restart from this checkpoint: '//why, err)
+    end subroutine refuse
+
+    subroutine open_group(loc, name, gid)
+      use hdf5, only: h5gopen_f
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      integer(hid_t), intent(out) :: gid
+      integer :: ie
+      call h5gopen_f(loc, name, gid, ie)
+      if (ie /= 0) ierr = 1
+    end subroutine open_group
+
+    integer function int_attr(name) result(v)
+      use hdf5, only: h5aopen_f, h5aread_f, h5aclose_f, H5T_NATIVE_INTEGER, hsize_t
+      character(len=*), intent(in) :: name
+      integer(hid_t) :: aid
+      integer(hsize_t) :: dims(1)
+      integer :: buf(1), ie
+      v = -1; dims = 1
+      call h5aopen_f(fid, name, aid, ie)
+      if (ie /= 0) then
+        ierr = 1; return
+      end if
+      call h5aread_f(aid, H5T_NATIVE_INTEGER, buf, dims, ie)
+      if (ie /= 0) ierr = 1
+      v = buf(1)
+      call h5aclose_f(aid, ie)
+    end function int_attr
+
+    ! The histories as recorded up to the checkpoint, in arrays with room to grow.
+    subroutine restore_history()
+      integer :: c, np_, d, ks
+      real(wp) :: ssc(2)
+      d = size(hist%px, 1); np_ = hist%nprobe
+      c = max(size(hist%t), nt, 16)
+      if (size(hist%t) < c) then
+        deallocate(hist%t, hist%kinetic, hist%strain, hist%gravity, hist%px, hist%pv, hist%ps)
+        allocate(hist%t(c), hist%kinetic(c), hist%strain(c), hist%gravity(c), &
+          hist%px(d, np_, c), hist%pv(d, np_, c), hist%ps(6, np_, c))
+      end if
+      hist%nt = nt
+      hist%tracked = nint(cnt(4)) == 1
+      hist%nset = nint(cnt(5))
+      if (nt > 0) then
+        call h5_read(g, 't', hist%t(1:nt), ierr)
+        call h5_read(g, 'kinetic', hist%kinetic(1:nt), ierr)
+        call h5_read(g, 'strain', hist%strain(1:nt), ierr)
+        call h5_read(g, 'gravity', hist%gravity(1:nt), ierr)
+        if (np_ > 0) then
+          allocate(r2(d * np_, nt))
+          call h5_read(g, 'px', r2, ierr); hist%px(:, :, 1:nt) = reshape(r2, [d, np_, nt])
+          call h5_read(g, 'pv', r2, ierr); hist%pv(:, :, 1:nt) = reshape(r2, [d, np_, nt])
+          deallocate(r2); allocate(r2(6 * np_, nt))
+          call h5_read(g, 'ps', r2, ierr); hist%ps(:, :, 1:nt) = reshape(r2, [6, np_, nt])
+          deallocate(r2)
+        end if
+      end if
+      if (allocated(hist%residual)) deallocate(hist%residual)
+      if (allocated(hist%set_name)) deallocate(hist%set_name, hist%reaction, hist%set_disp)
+      if (hist%tracked) then
+        ! Tracking and its node sets come from the case file, as when they were recorded.
+        if (hist%nset /= model%nodes%nset) then
+          call refuse('its reaction sets do not match the case file'); return
+        end if
+        allocate(hist%residual(c), hist%set_name(hist%nset), &
+          hist%reaction(nd, hist%nset, c), hist%set_disp(nd, hist%nset, c))
+        hist%set_name = model%nodes%set_name(1:hist%nset)
+        if (nt > 0) then
+          call h5_read(g, 'residual', hist%residual(1:nt), ierr)
+          if (hist%nset > 0) then
+            allocate(r2(nd * hist%nset, nt))
+            call h5_read(g, 'reaction', r2, ierr)
+            hist%reaction(:, :, 1:nt) = reshape(r2, [nd, hist%nset, nt])
+            call h5_read(g, 'set_disp', r2, ierr)
+            hist%set_disp(:, :, 1:nt) = reshape(r2, [nd, hist%nset, nt])
+            deallocate(r2)
+          end if
+        end if
+      end if
+      hist%nsnap = nint(cnt(3))
+      call open_group(g, 'snapshots', gs)
+      do ks = 1, hist%nsnap
+        call open_group(gs, str(ks), gk)
+        associate (sn => hist%snap(ks))
+          call h5_read(gk, 'scalars', ssc, ierr)
+          sn%t = ssc(1); sn%step = nint(ssc(2))
+          call read2(gk, 'x', d, np, sn%x); call read2(gk, 'v', d, np, sn%v)
+          call read2(gk, 'stress', 6, np, sn%stress)
+          call read2(gk, 'strain', 6, np, sn%strain)
+          call read1(gk, 'm', np, sn%m); call read1(gk, 'vol', np, sn%vol)
+          call read1(gk, 'rho', np, sn%rho)
+          call read2(gk, 'state', ns, np, sn%state)
+        end associate
+        call h5_close_group(gk, ierr)
+      end do
+      call h5_close_group(gs, ierr)
+    end subroutine restore_history
+
+    subroutine read1(loc, name, m, a)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: m
+      real(wp), allocatable, intent(out) :: a(:)
+      allocate(a(m))
+      if (m > 0) call h5_read(loc, name, a, ierr)
+    end subroutine read1
+
+    subroutine read2(loc, name, m1, m2, a)
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: m1, m2
+      real(wp), allocatable, intent(out) :: a(:,:)
+      allocate(a(m1, m2))
+      if (m1 * m2 > 0) call h5_read(loc, name, a, ierr)
+    end subroutine read2
+  end subroutine empm_checkpoint_read
+
+  !> 'line N: "..." here, "..." in the checkpoint' for the first line where two texts differ.
+  pure function first_difference(saved, now) result(msg)
+    character(len=*), intent(in) :: saved, now
+    character(len=:), allocatable :: msg
+    integer :: i, line, a0, b0, a1, b1
+    line = 1; a0 = 1; b0 = 1
+    do i = 1, min(len(saved), len(now))
+      if (saved(i:i) /= now(i:i)) exit
+      if (now(i:i) == new_line('a')) then
+        line = line + 1; a0 = i + 1; b0 = i + 1
+      end if
+    end do
+    a1 = index(saved(a0:), new_line('a')); b1 = index(now(b0:), new_line('a'))
+    if (a1 == 0) then
+      a1 = len(saved)
+    else
+      a1 = a0 + a1 - 2
+    end if
+    if (b1 == 0) then
+      b1 = len(now)
+    else
+      b1 = b0 + b1 - 2
+    end if
+    msg = 'line '//str(line)//' is "'//now(b0:b1)//'" here, "'//saved(a0:a1)// &
+      '" in the checkpoint'
+  end function first_difference
+end module empm_checkpoint
