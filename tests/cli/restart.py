@@ -14,6 +14,8 @@
             the uninterrupted run.
   signals   SIGINT and SIGTERM: exit 130 / 143, a checkpoint and the results so far (marked
             incomplete) written; the restart completes bitwise.
+  seconds   checkpoints by wall time (checkpoint_seconds): written during the run, and the
+            restart from the one before the last is bitwise.
   refuse    a checkpoint of another case file (one value changed), of another version, a
             damaged one, a results file and a missing file: each refused with status 2 and
             the reason.
@@ -260,6 +262,13 @@ def signals(empm, work):
             fail(f"{sig.name}: the restarted run differs: {bad[:6]}")
 
 
+def seconds(empm, work):
+    text = (CASE_1D.format(shape="linear", scheme="pc_newmark")
+            .replace("t_end = 3.0", "t_end = 300.0")
+            .replace("checkpoint_every = 40", "checkpoint_every = 0, checkpoint_seconds = 0.25"))
+    restart_equals(empm, work, "wall", text)
+
+
 def refuse(empm, work):
     case = os.path.join(work, "r.nml")
     text = CASE_1D.format(shape="linear", scheme="pc_newmark")
@@ -309,7 +318,7 @@ def main():
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     {"matrix": matrix, "threads": threads, "geotech": geotech, "sigkill": sigkill,
-     "signals": signals, "refuse": refuse}[scenario](empm, work)
+     "signals": signals, "seconds": seconds, "refuse": refuse}[scenario](empm, work)
     print("PASS")
 
 
