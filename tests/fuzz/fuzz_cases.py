@@ -131,6 +131,13 @@ def run_one(empm, case, work, timeout):
     return f"exit {p.returncode}", "", time.time() - t0
 
 
+# Seeds whose 300 capped steps alone exceed the 10 s limit per run in a Debug build (the cap
+# bounds the steps, not their cost): left out, with the reason.
+HEAVY = {
+    "footing_fine.nml": "6,144 particles with LME shapes: about 30 ms per Debug step",
+}
+
+
 def main():
     args = [a for a in sys.argv[1:] if not a.startswith("--")]
     opts = dict(zip(sys.argv[1::1], sys.argv[2::1]))
@@ -148,7 +155,7 @@ def main():
     seeds = []
     for d in ("examples", "verification"):
         for f in sorted(os.listdir(os.path.join(src, d))):
-            if f.endswith(".nml"):
+            if f.endswith(".nml") and f not in HEAVY:
                 seeds.append(open(os.path.join(src, d, f)).read())
     corpus_dir = os.path.join(src, "tests", "fuzz", "corpus")
     corpus = sorted(os.listdir(corpus_dir)) if os.path.isdir(corpus_dir) else []
