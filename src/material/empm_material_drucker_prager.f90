@@ -51,6 +51,7 @@ module empm_material_drucker_prager
   !> Largest apex or cut-off kept: a cone with φ so small that ξc/η would overflow has,
   !> in practice, no apex.
   real(wp), parameter :: NO_APEX = 1.0e300_wp
+  integer, parameter :: SUBSTEP_LEVELS = 16 !! substeps down to 2^-16 of a step
 
   !> Drucker–Prager material (perfect plasticity, non-associated, tension cut-off).
   type, extends(empm_material_t) :: empm_drucker_prager_t
@@ -71,6 +72,7 @@ module empm_material_drucker_prager
     real(wp) :: T = NO_APEX       !! tension cut-off on m [Pa], 0 <= T <= m_A
     real(wp) :: tT = 0.0_wp       !! cone radius at the cut-off, t_T = ξc − ηT >= 0 [Pa]
     real(wp) :: H = 0.0_wp        !! G + K η η_ψ, the cone return's modulus [Pa]
+    real(wp) :: substep_tol = 0.0_wp !! substepping tolerance (0: one return per step)
   contains
     procedure :: init => dp_init
     procedure :: configure => dp_configure
@@ -169,7 +171,7 @@ contains
     type(empm_group_t), intent(inout) :: group          !! the `&material` group
     type(empm_error_t), intent(inout) :: err            !! set on a missing or invalid value
     type(empm_param_t), allocatable :: p(:)
-    real(wp) :: E, nu, rho0, c, phi, psi, T
+    real(wp) :: E, nu, rho0, c, phi, psi, T, tol
     character(len=:), allocatable :: match
     character(len=32) :: buf
     integer :: info
@@ -181,12 +183,15 @@ contains
     call group%get(p(3), psi, err)
     call group%get(p(4), T, err)
     call group%get(p(5), match, err)
+    tol = 0.0_wp
+    call group%get(p(6), tol, err)
     if (err%code /= 0) return
     if (psi > phi) then
       call group%fail(err, p(3)%name, 'the dilatancy angle must not exceed friction_angle')
       return
     end if
     call self%init(E, nu, rho0, c, phi, psi, match, T, info)
+    self%substep_tol = tol
     if (info /= 0) then
       write(buf, '(es12.5)') self%apex
       call group%fail(err, p(4)%name, 'the tension cut-off must not exceed the cone''s apex '// &
@@ -210,7 +215,11 @@ contains
         '(none when friction_angle = 0)', lo=0.0_wp, hi=1.0e30_wp, optional=.true.), &
       empm_param('match', PARAM_STR, '-', 'cone matched to Mohr-Coulomb in plane strain, at '// &
         'the triaxial compression (outer) or the triaxial extension (inner) corners', &
-        default="'plane_strain'", choices='plane_strain compression extension')]
+        default="'plane_strain'", choices='plane_strain compression extension'), &
+      empm_param('substep_tolerance', PARAM_REAL, '-', 'relative local error of the return '// &
+        'per substep (one return against two over the halves, extrapolated); 0: one return '// &
+        'per step, first order in the increment on non-coaxial paths (docs/materials.md)', &
+        default='0', lo=0.0_wp, hi=1.0e-2_wp)]
   end function dp_own_params
 
   !> Registry name "drucker_prager".
@@ -379,6 +388,11 @@ contains
       end if
       strain(:,p) = strain(:,p) + de
       call jaumann_rotate(dt, L(:,:,p), stress(:,p))
+      if (self%substep_tol > 0.0_wp) then
+        call dp_integrate(self, stress(:,p), de, state(1,p), state(2,p))
+        rho(p) = rho(p) / (1.0_wp + tr)
+        cycle
+      end if
       ! The elastic predictor in linear_elastic's operation order: with an unreachable
       ! strength the two models agree bitwise.
       sig(1:3) = stress(1:3,p) + self%lambda * tr + 2.0_wp * self%G * de(1:3)
@@ -391,6 +405,98 @@ contains
       rho(p) = rho(p) / (1.0_wp + tr)
     end do
   end subroutine dp_update
+
+  !> One return over the strain increment `de` from the (rotated) stress `s`, accumulating the
+  !> plastic strains; `region` is the return's DP_* region.
+  pure subroutine dp_step(self, s, de, e_eq, e_vol, region)
+    class(empm_drucker_prager_t), intent(in) :: self
+    real(wp), intent(inout) :: s(6), e_eq, e_vol
+    real(wp), intent(in) :: de(6)
+    integer, intent(out) :: region
+    real(wp) :: sig(6), tr, m_tr, t_tr, m, t
+    tr = de(1) + de(2) + de(3)
+    sig(1:3) = s(1:3) + self%lambda * tr + 2.0_wp * self%G * de(1:3)
+    sig(4:6) = s(4:6) + 2.0_wp * self%G * de(4:6)
+    call empm_dp_return(self, sig, s, region, m_tr, t_tr, m, t)
+    if (region /= DP_ELASTIC) then
+      e_eq = e_eq + (t_tr - t) / (sqrt(3.0_wp) * self%G)
+      e_vol = e_vol + (m_tr - m) / self%K
+    end if
+  end subroutine dp_step
+
+  !> Error-controlled integration of one point over `de` (`substep_tolerance` > 0): the
+  !> elastic part of the increment first (the fraction a where the straight elastic path leaves
+  !> the admissible set, by bisection: one and two returns agree exactly while the first half is
+  !> elastic, so the estimate would be blind to it), then substeps 2^-l of the plastic part
+  !> (l ≤ 16), each accepted when one return over it and two over its halves agree to the
+  !> tolerance (relative to |σ| + ξc), with local extrapolation 2σ_two − σ_one (backward Euler
+  !> is first order: the extrapolated value is second order). The result is returned to the
+  !> surface once more (a zero increment) so that it is admissible to round-off. On paths where
+  !> a single return is exact (coaxial) the first substep is accepted at once.
+  pure subroutine dp_integrate(self, s, de, e_eq, e_vol)
+    class(empm_drucker_prager_t), intent(in) :: self
+    real(wp), intent(inout) :: s(6), e_eq, e_vol
+    real(wp), intent(in) :: de(6)
+    real(wp) :: sa(6), sb(6), a1, a2, b1, b2, dsig(6), tr, lo, hi, mid, a, h
+    integer :: region, rb, lev, pos, span, it
+    sa = s; a1 = e_eq; a2 = e_vol
+    call dp_step(self, sa, de, a1, a2, region)
+    if (region == DP_ELASTIC) then
+      s = sa; e_eq = a1; e_vol = a2; return
+    end if
+    tr = de(1) + de(2) + de(3)
+    dsig(1:3) = self%lambda * tr + 2.0_wp * self%G * de(1:3)
+    dsig(4:6) = 2.0_wp * self%G * de(4:6)
+    a = 0.0_wp
+    if (admissible(s, 0.0_wp)) then
+      lo = 0.0_wp; hi = 1.0_wp
+      do it = 1, 60
+        mid = 0.5_wp * (lo + hi)
+        if (admissible(s + mid * dsig, 0.0_wp)) then
+          lo = mid
+        else
+          hi = mid
+        end if
+      end do
+      a = lo
+      s = s + a * dsig
+    end if
+    lev = 0; pos = 0
+    do while (pos < 2**SUBSTEP_LEVELS)
+      span = 2**(SUBSTEP_LEVELS - lev)
+      h = (1.0_wp - a) * real(span, wp) / 2**SUBSTEP_LEVELS
+      sa = s; a1 = e_eq; a2 = e_vol
+      call dp_step(self, sa, h * de, a1, a2, region)
+      if (region == DP_ELASTIC) then
+        s = sa; e_eq = a1; e_vol = a2; pos = pos + span; cycle
+      end if
+      sb = s; b1 = e_eq; b2 = e_vol
+      call dp_step(self, sb, 0.5_wp * h * de, b1, b2, rb)
+      call dp_step(self, sb, 0.5_wp * h * de, b1, b2, rb)
+      if (lev == SUBSTEP_LEVELS .or. maxval(abs(sb - sa)) <= self%substep_tol * &
+          (maxval(abs(sb)) + self%xic)) then
+        s = 2.0_wp * sb - sa; e_eq = 2.0_wp * b1 - a1; e_vol = 2.0_wp * b2 - a2
+        pos = pos + span
+        if (lev > 0) then
+          if (mod(pos, 2 * span) == 0) lev = lev - 1
+        end if
+      else
+        lev = lev + 1
+      end if
+    end do
+    call dp_step(self, s, [0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp, 0.0_wp], e_eq, e_vol, &
+      region)
+  contains
+    ! The stress x is inside the cone and below the cut-off, with a margin `tol` [Pa].
+    pure logical function admissible(x, tol)
+      real(wp), intent(in) :: x(6), tol
+      real(wp) :: mm, tt
+      mm = (x(1) + x(2) + x(3)) / 3.0_wp
+      tt = sqrt(0.5_wp * ((x(1) - mm)**2 + (x(2) - mm)**2 + (x(3) - mm)**2) + x(4)**2 + &
+        x(5)**2 + x(6)**2)
+      admissible = tt + self%eta * mm - self%xic <= tol .and. mm <= self%T + tol
+    end function admissible
+  end subroutine dp_integrate
 
   !> Elastic P-wave speed sqrt((λ + 2G)/ρ) [m/s] (plastic flow only softens the response).
   pure real(wp) function dp_wave_speed(self, rho)
