@@ -239,7 +239,8 @@ contains
     write(u, '(a)') 'cohesion = 500, friction_angle = 30, dilatancy_angle = 5; camclay: lambda ='
     write(u, '(a)') '0.2, kappa = 0.04, M = 1.2, e0 = 1, ocr = 1); --material-keys replaces keys of'
     write(u, '(a)') 'the same name and adds others. The block starts under an isotropic pressure'
-    write(u, '(a)') 'P0 [Pa] (default: 1e4 for camclay, 0 otherwise). A umat library path is'
+    write(u, '(a)') 'P0 [Pa] (default: 1e4 for camclay, 0 otherwise), between smooth rigid walls'
+    write(u, '(a)') 'when P0 > 0 (so that it stays confined). A umat library path is'
     write(u, '(a)') 'relative to the working folder. "plastic_fraction" in the output is the'
     write(u, '(a)') 'share of particle updates that changed a state variable.'
   end subroutine usage_bench

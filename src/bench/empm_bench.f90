@@ -8,7 +8,8 @@
 !> the particle count never depends on the family. The shape and the scheme are named as in a
 !> case file (`lme_g3`, `pc_newmark`) and created through the registry: nothing here knows a
 !> family. The initial velocity is a smooth standing-wave field of
-!> small amplitude (the block is linear elastic and nothing is fixed); Δt is half the CFL limit.
+!> small amplitude (nothing is fixed, unless the block starts confined: then it stands between
+!> smooth rigid walls, so that it stays confined); Δt is half the CFL limit.
 !> The timed loop calls the integrator's `step` only: no guards, no last-good copy, no output.
 !>
 !> The material is any registered model (`--material`, default linear_elastic) with the bench's
@@ -22,7 +23,7 @@ module empm_bench
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp, pi
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_USAGE, EMPM_ERR_RUNTIME
-  use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
+  use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK, STEP_MATERIAL_FAILED
   use empm_particle_gen, only: empm_fill, GEOM_BOX, PLACE_GAUSS
   use empm_namelist, only: empm_kv
   use empm_registry, only: empm_create_shape, empm_create_material, empm_create_integrator, &
@@ -94,7 +95,9 @@ contains
     class(empm_integrator_t), allocatable :: integ
     type(empm_step_status_t) :: stat
     type(empm_error_t) :: e
-    real(wp) :: zero3(3), hi(3), origin(3), h(3), dt, s, p0
+    real(wp) :: zero3(3), hi(3), origin(3), h(3), dt, s, p0, lo3(3), hi3(3)
+    logical :: fixk(3)
+    integer :: nfix
     integer :: nper, pad, nd, info, nadd, p, d, k, ncell(3)
     integer(int64) :: rss0, rss1, c0, c1, rate, ticks, nchanged
     real(wp), allocatable :: state0(:,:)
@@ -166,6 +169,18 @@ contains
         model%pts%v(d, p) = s
       end do
     end do
+    ! A confined block must stay confined: a free block under −p0 I is not in equilibrium and
+    ! would expand (a Cam-Clay block by far more than the grid). The walls x_k = 0 and 1 are
+    ! smooth and rigid (normal velocity 0; the standing wave's normal component vanishes there).
+    if (p0 > 0.0_wp) then
+      do k = 1, nd
+        lo3 = -1.0e30_wp; hi3 = 1.0e30_wp; hi3(k) = 0.0_wp
+        fixk = .false.; fixk(k) = .true.
+        call model%nodes%fix_box(model%grid, lo3, hi3, fixk, zero3, nfix)
+        lo3 = -1.0e30_wp; hi3 = 1.0e30_wp; lo3(k) = 1.0_wp
+        call model%nodes%fix_box(model%grid, lo3, hi3, fixk, zero3, nfix)
+      end do
+    end if
     call model%finalize_setup()
     call integ%prepare(model)
     dt = 0.5_wp * empm_stable_dt(model)
@@ -217,8 +232,15 @@ contains
     subroutine advance()
       call integ%step(model, dt, stat)
       if (stat%code /= STEP_OK) then
-        call empm_raise(EMPM_ERR_RUNTIME, 'bench: step '//str(model%step + 1)// &
-          ' failed at particle '//str(stat%particle)//' (status '//str(stat%detail)//')', err)
+        if (stat%code == STEP_MATERIAL_FAILED .and. stat%detail >= 1 .and. &
+            stat%detail <= size(model%mats)) then
+          call empm_raise(EMPM_ERR_RUNTIME, 'bench: step '//str(model%step + 1)// &
+            ' failed at particle '//str(stat%particle)//': '// &
+            model%mats(stat%detail)%model%failure_text(), err)
+        else
+          call empm_raise(EMPM_ERR_RUNTIME, 'bench: step '//str(model%step + 1)// &
+            ' failed at particle '//str(stat%particle)//' (status '//str(stat%detail)//')', err)
+        end if
         return
       end if
       model%t = model%t + dt

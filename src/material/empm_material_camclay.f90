@@ -18,17 +18,21 @@
 !>   exponentials, q = q_tr(G)/(1 + 6GΔγ/M²) with G = G(p'ₙ₊₁) (radial return, isotropic
 !>   elasticity), residuals u + v Δγ (2p' − p'c) = 0 and f/p'cₙ² = 0, solved with a 2×2
 !>   Newton to 1e-12 relative.
-!> - Error control: a substep that starts inside the yield surface and ends outside it first
-!>   takes its elastic part exactly (the crossing fraction by regula falsi); a plastic substep
-!>   is compared with two half substeps; their difference (relative to p'c) must be below
-!>   `TOL_SUB` = 1e-8, otherwise the substep shrinks (it grows again after a success). The
-!>   result kept is the local extrapolation 2·(two halves) − (one step), second order. This
-!>   makes the result independent of how a strain increment is split: measured ≤ 7e-10
-!>   relative (docs/materials.md gives the figures and the cost).
+!> - By default (`substep_tolerance` = 0) one such return per call, the fast path for explicit
+!>   MPM steps; when its Newton iteration fails, the increment is substepped with error control
+!>   at 1e-6 instead of stopping the run.
+!> - Error control (`substep_tolerance` > 0): a substep that starts inside the yield surface and
+!>   ends outside it first takes its elastic part exactly (the crossing fraction by regula
+!>   falsi); a plastic substep is compared with two half substeps; their difference (relative to
+!>   p'c) must be below the tolerance, otherwise the substep shrinks (it grows again after a
+!>   success). The result kept is the local extrapolation 2·(two halves) − (one step), second
+!>   order. At 1e-8 this makes the result independent of how a strain increment is split:
+!>   measured ≤ 7e-10 relative (docs/materials.md gives the figures and the cost).
 !>
 !> State variables: `pc` (p'c, Pa), `v` (specific volume), `resolved` (1 once `pc` and `v` are
 !> known: with `ocr` or `N` they follow from the stress at the first update).
 module empm_material_camclay
+  use, intrinsic :: iso_c_binding, only: c_double
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t
   use empm_params, only: empm_param_t, empm_param, PARAM_REAL
@@ -41,7 +45,11 @@ module empm_material_camclay
 
   real(wp), parameter :: TOL_NEWTON = 1.0e-12_wp !! relative residual of the local Newton
   integer, parameter :: MAXIT = 40               !! Newton iterations per return mapping
-  real(wp), parameter :: TOL_SUB = 1.0e-8_wp     !! one step vs two half steps, relative to p'c
+  real(wp), parameter :: FALLBACK_TOL = 1.0e-6_wp !! error control when one return failed
+  ! 1/k! for the series of phi (e^x − 1)/x.
+  real(wp), parameter :: R2 = 1.0_wp / 2.0_wp, R3 = 1.0_wp / 6.0_wp, R4 = 1.0_wp / 24.0_wp, &
+    R5 = 1.0_wp / 120.0_wp, R6 = 1.0_wp / 720.0_wp, R7 = 1.0_wp / 5040.0_wp, &
+    R8 = 1.0_wp / 40320.0_wp, R9 = 1.0_wp / 362880.0_wp, R10 = 1.0_wp / 3628800.0_wp
   integer, parameter :: MAXSUB = 5000            !! substeps per particle update
   real(wp), parameter :: HMIN = 1.0e-9_wp        !! smallest substep (fraction of the increment)
   real(wp), parameter :: EXP_CAP = 200.0_wp      !! exponent cap (no overflow in a failing Newton)
@@ -53,6 +61,18 @@ module empm_material_camclay
     integer :: newton = 0     !! Newton iterations, all return mappings together
     integer :: mappings = 0   !! plastic return mappings solved
   end type camclay_stats_t
+
+  ! Why an update failed (the one cause, for failure_text).
+  integer, parameter :: WHY_VOLUME = 1, WHY_RESOLVE = 2, WHY_RETURN = 3
+
+  !> The last failure of an update: its cause and the particle's state at the step's start.
+  type :: camclay_failure_t
+    integer :: why = 0           !! WHY_* (0: none recorded)
+    real(wp) :: p = 0.0_wp       !! p' [Pa]
+    real(wp) :: q = 0.0_wp       !! q [Pa]
+    real(wp) :: pc = 0.0_wp      !! p'c [Pa]
+    real(wp) :: de = 0.0_wp      !! tr Δε (WHY_VOLUME) or |Δε| (WHY_RETURN)
+  end type camclay_failure_t
 
   !> Modified Cam-Clay material (see the module notes).
   type, extends(empm_material_t) :: empm_camclay_t
@@ -67,7 +87,10 @@ module empm_material_camclay
     real(wp) :: nu = 0.0_wp      !! Poisson's ratio (constant-ν elasticity)
     real(wp) :: G = 0.0_wp       !! constant shear modulus [Pa] (0: constant ν instead)
     real(wp) :: p_min = 1.0_wp   !! confinement floor [Pa]
+    real(wp) :: substep_tol = 0.0_wp !! error control of the substeps (0: one return per call)
     real(wp) :: alpha = 0.0_wp   !! G/K = 3(1 − 2ν)/(2(1 + ν)) for constant ν
+    type(camclay_failure_t), pointer :: failure => null() !! the last failure (a pointer, so
+                                                          !! that `update` can record it)
   contains
     procedure :: configure => cc_configure
     procedure :: family => cc_family
@@ -84,6 +107,16 @@ module empm_material_camclay
     procedure :: resolve => cc_resolve
     procedure :: shear_modulus => cc_shear_modulus
   end type empm_camclay_t
+
+  interface
+    !> C99 expm1 (libm): e^x − 1 without cancellation near 0. Declared pure: it has no side
+    !> effects for finite arguments (it may set errno on overflow, which the caller caps).
+    pure function c_expm1(x) bind(C, name='expm1') result(y)
+      import :: c_double
+      real(c_double), value :: x
+      real(c_double) :: y
+    end function c_expm1
+  end interface
 
 contains
 
@@ -142,7 +175,11 @@ contains
         lo_open=.true., hi=1.0e30_wp, optional=.true.), &
       empm_param('p_min', PARAM_REAL, 'Pa', 'confinement floor: a particle with p'' < p_min '// &
         'starts its update at p'' = p_min (so that K = v p''/kappa > 0)', default='1', &
-        lo=0.0_wp, lo_open=.true., hi=1.0e30_wp)]
+        lo=0.0_wp, lo_open=.true., hi=1.0e30_wp), &
+      empm_param('substep_tolerance', PARAM_REAL, '-', 'error control: a plastic substep '// &
+        'against two half substeps, relative to p''c (e.g. 1e-8: independent of the split '// &
+        'to 1e-8); 0: one backward-Euler return per call, substepped only when its Newton '// &
+        'iteration fails (docs/materials.md)', default='0', lo=0.0_wp, hi=1.0e-2_wp)]
   end function cc_params
 
   !> Read and validate the keys; each pair must have exactly one member given.
@@ -153,6 +190,7 @@ contains
     type(empm_param_t), allocatable :: p(:)
     real(wp) :: phi, x
     real(wp), parameter :: PI = acos(-1.0_wp)
+    if (.not. associated(self%failure)) allocate(self%failure)
     allocate(p, source=cc_params(self))
     call group%get(p(1), self%rho0, err)
     call group%get(p(2), self%lam, err)
@@ -202,6 +240,7 @@ contains
       self%alpha = 0.0_wp
     end if
     call group%get(p(13), self%p_min, err)
+    call group%get(p(14), self%substep_tol, err)
     if (err%code /= 0) return
     if (self%pc0 > 0.0_wp .and. .not. self%p_min < self%pc0) &
       call group%fail(err, 'p_min', 'p_min must be smaller than pc0')
@@ -265,7 +304,7 @@ contains
   !> increment. `info = k > 0`: particle k (the first) failed and is left unchanged (volume
   !> ratio ≤ 0, v not positive at resolution, or the return mapping did not converge); −1:
   !> array extents disagree. F is not tracked (left as it is).
-  pure subroutine cc_update(self, dt, L, F, strain, stress, state, rho, ctx, info)
+  subroutine cc_update(self, dt, L, F, strain, stress, state, rho, ctx, info)
     class(empm_camclay_t), intent(in) :: self        !! material
     real(wp), intent(in) :: dt                       !! time step [s]
     real(wp), intent(in), contiguous :: L(:,:,:)       !! velocity gradient (3,3,n) [1/s]
@@ -294,26 +333,42 @@ contains
       ! A volume ratio exp(tr) beyond e^±1 in one step is no soil increment: refuse it.
       if (.not. (abs(tr) < 1.0_wp .and. 1.0_wp + tr > 0.0_wp)) then
         if (info == 0) info = p
+        call record(WHY_VOLUME, stress(:,p), state(1,p), tr)
         cycle
       end if
       sig = stress(:,p)
       st = state(1:3,p)
-      call self%resolve(sig, st, ok)
+      ! Module procedures called directly: no dispatch per particle.
+      call cc_resolve(self, sig, st, ok)
       if (.not. ok) then
         if (info == 0) info = p
+        call record(WHY_RESOLVE, sig, st(1), 0.0_wp)
         cycle
       end if
       call jaumann_rotate(dt, L(:,:,p), sig)
-      call self%integrate(de, sig, st, status, stats)
+      call cc_integrate(self, de, sig, st, status, stats)
       if (status /= 0) then
         if (info == 0) info = p
+        call record(WHY_RETURN, stress(:,p), state(1,p), sqrt(sum(de**2)))
         cycle
       end if
       strain(:,p) = strain(:,p) + de
       stress(:,p) = sig
       state(1:3,p) = st
-      rho(p) = rho(p) * exp(-tr)
+      rho(p) = rho(p) * fexp(-tr)
     end do
+  contains
+    ! Record a failure (rare: once per failing particle), one thread at a time.
+    subroutine record(why, sig0, pc, x)
+      integer, intent(in) :: why
+      real(wp), intent(in) :: sig0(6), pc, x
+      real(wp) :: m, dev(6), q
+      if (.not. associated(self%failure)) return
+      call mean_deviator(sig0, m, dev, q)
+      !$omp critical (empm_camclay_failure)
+      self%failure = camclay_failure_t(why, -m, q, pc, x)
+      !$omp end critical (empm_camclay_failure)
+    end subroutine record
   end subroutine cc_update
 
   !> Shear modulus at p' (floored at p_min) and v: α v p'/κ (constant ν) or the constant G.
@@ -341,14 +396,32 @@ contains
     integer, intent(out) :: status             !! 0 ok, 1 failed
     type(camclay_stats_t), intent(out) :: stats !! substeps, Newton iterations
     real(wp) :: s0(6), pc0, v0, s1(6), pc1, v1, sh(6), pch, vh, s2(6), pc2, v2
-    real(wp) :: t, h, hs, err, m, dev(6), q, fy, a
+    real(wp) :: t, h, hs, err, m, dev(6), q, fy, a, tol
     logical :: ok, plastic, last
     integer :: nit
     status = 0
     s0 = sig; pc0 = max(st(1), self%p_min); v0 = st(2)
-    call mean_deviator(s0, m, dev, q)
     ! The confinement floor: a particle with p' < p_min starts at p' = p_min.
-    if (-m < self%p_min) s0(1:3) = dev(1:3) - self%p_min
+    if (-(s0(1) + s0(2) + s0(3)) / 3.0_wp < self%p_min) then
+      call mean_deviator(s0, m, dev, q)
+      s0(1:3) = dev(1:3) - self%p_min
+    end if
+    tol = self%substep_tol
+    if (tol <= 0.0_wp) then
+      ! One backward-Euler return over the whole increment (the common, fast case); only when
+      ! its Newton iteration fails is the increment substepped, with error control.
+      s1 = s0; pc1 = pc0; v1 = v0
+      call be_step(self, de, s1, pc1, v1, ok, plastic, nit)
+      stats%newton = nit
+      if (plastic) stats%mappings = 1
+      if (ok) then
+        stats%substeps = 1
+        sig = s1; st(1) = pc1; st(2) = v1
+        return
+      end if
+      stats%rejected = 1
+      tol = FALLBACK_TOL
+    end if
     t = 0.0_wp; h = 1.0_wp
     do
       if (stats%substeps + stats%rejected >= MAXSUB .or. h < HMIN) then
@@ -396,9 +469,9 @@ contains
           stats%rejected = stats%rejected + 1; h = 0.25_wp * h; cycle
         end if
         err = max(maxval(abs(s2 - s1)), abs(pc2 - pc1)) / max(pc1, pc2)
-        if (err > TOL_SUB) then
+        if (err > tol) then
           stats%rejected = stats%rejected + 1
-          h = h * max(0.1_wp, 0.9_wp * sqrt(TOL_SUB / err))
+          h = h * max(0.1_wp, 0.9_wp * sqrt(tol / err))
           cycle
         end if
         ! Local extrapolation: the two estimates are first order with errors in the ratio 2:1,
@@ -407,7 +480,7 @@ contains
         s1 = 2.0_wp * s2 - s1; pc1 = 2.0_wp * pc2 - pc1; v1 = v2
         hs = h
         ! Grow the next substep (first-order local error ~ h²).
-        h = h * min(4.0_wp, 0.9_wp * sqrt(TOL_SUB / max(err, 1.0e-300_wp)))
+        h = h * min(4.0_wp, 0.9_wp * sqrt(tol / max(err, 1.0e-300_wp)))
       else
         hs = h
         h = 4.0_wp * h
@@ -429,21 +502,23 @@ contains
     real(wp), intent(inout) :: s(6), pc, v
     logical, intent(out) :: ok, plastic
     integer, intent(out) :: nit
-    real(wp) :: m, dev(6), q, pn, tr, v1, dV, x, ksec, gsec, ded(6), str(6), qtr, ptr, f
+    real(wp) :: m, dev(6), pn, tr, v1, dV, x, ksec, gsec, ded(6), str(6), qtr, ptr, f
     real(wp) :: a, b, c, u, dg, p, pc1, G, dGu, qtr2, dqtr, D, qn, dq_du, dq_dg
     real(wp) :: Ra, Rb, Ra_u, Ra_g, Rb_u, Rb_g, det, du, ddg, S2, M2, lk, sq(6)
     ok = .true.; plastic = .false.; nit = 0
     M2 = self%M**2; lk = self%lam - self%kap
-    call mean_deviator(s, m, dev, q)
+    ! Mean stress and deviator (q is not needed here: no square root on the elastic path).
+    m = (s(1) + s(2) + s(3)) / 3.0_wp
+    dev(1:3) = s(1:3) - m; dev(4:6) = s(4:6)
     pn = -m
     tr = de(1) + de(2) + de(3)
-    v1 = v * exp(tr)
+    v1 = v * fexp(tr)
     dV = v * tr * phi(tr)                 ! v1 − v without cancellation
     ded(1:3) = de(1:3) - tr / 3.0_wp
     ded(4:6) = de(4:6)
     ! Exact elastic predictor.
     x = -dV / self%kap
-    ptr = pn * exp(x)
+    ptr = pn * fexp(x)
     if (self%G > 0.0_wp) then
       gsec = self%G
     else
@@ -451,8 +526,9 @@ contains
       gsec = self%alpha * ksec
     end if
     str = dev + 2.0_wp * gsec * ded
-    qtr = sqrt(1.5_wp * sum(str(1:3)**2) + 3.0_wp * sum(str(4:6)**2))
-    f = qtr**2 / M2 + ptr * (ptr - pc)
+    qtr2 = 1.5_wp * (str(1)**2 + str(2)**2 + str(3)**2) + 3.0_wp * (str(4)**2 + str(5)**2 + &
+      str(6)**2)
+    f = qtr2 / M2 + ptr * (ptr - pc)
     if (f <= 0.0_wp) then
       s(1:3) = str(1:3) - ptr; s(4:6) = str(4:6)
       v = v1
@@ -466,8 +542,8 @@ contains
     S2 = pc**2
     u = 0.0_wp; dg = 0.0_wp
     do
-      p = pn * exp(min((u - dV) / self%kap, EXP_CAP))
-      pc1 = pc * exp(min(-u / lk, EXP_CAP))
+      p = pn * fexp(min((u - dV) / self%kap, EXP_CAP))
+      pc1 = pc * fexp(min(-u / lk, EXP_CAP))
       if (self%G > 0.0_wp) then
         G = self%G; dGu = 0.0_wp
       else
@@ -573,19 +649,33 @@ contains
   !> φ(x) = (eˣ − 1)/x, φ(0) = 1, accurate for all x (series near 0, where eˣ − 1 cancels).
   pure elemental real(wp) function phi(x)
     real(wp), intent(in) :: x
-    real(wp) :: term
-    integer :: k
-    if (abs(x) < 0.5_wp) then
-      ! Σ xᵏ/(k+1)!, k = 0..20: the first omitted term is below 0.5²¹/22! ≈ 4e-28.
-      phi = 1.0_wp; term = 1.0_wp
-      do k = 1, 20
-        term = term * x / real(k + 1, wp)
-        phi = phi + term
-      end do
+    real(wp) :: x2, x4
+    if (abs(x) < 0.05_wp) then
+      ! Σ xᵏ/(k+1)!, k = 0..9 (Horner): the first omitted term is below 0.05¹⁰/11! ≈ 2.4e-21.
+      ! MPM increments land here: a few multiply-adds (a 20-term series with a division per
+      ! term was most of a Cam-Clay update).
+      ! Estrin's scheme: the same polynomial in pairs, a dependency chain of 4 multiply-adds
+      ! instead of 9 (the update is bound by latency, and this runs 4-8 times per update).
+      x2 = x * x
+      x4 = x2 * x2
+      phi = ((1.0_wp + R2 * x) + x2 * (R3 + R4 * x)) + x4 * ((R5 + R6 * x) + x2 * (R7 + R8 * x)) &
+        + (x4 * x4) * (R9 + R10 * x)
     else
-      phi = (exp(min(x, EXP_CAP)) - 1.0_wp) / x
+      ! expm1 has no cancellation for small x (C99's, through libm).
+      phi = c_expm1(min(x, EXP_CAP)) / x
     end if
   end function phi
+
+  !> e^x: for |x| < 0.05 (the exponents of an MPM step's increment) 1 + x·phi(x), equal to exp
+  !> to the last bit or two, at a fraction of a library call; else exp.
+  pure elemental real(wp) function fexp(x)
+    real(wp), intent(in) :: x
+    if (abs(x) < 0.05_wp) then
+      fexp = 1.0_wp + x * phi(x)
+    else
+      fexp = exp(x)
+    end if
+  end function fexp
 
   ! ---- wave speeds, energy, failure text ---------------------------------------------------
 
@@ -611,7 +701,8 @@ contains
     real(wp), intent(in) :: state(:,:)         !! state variables (nstate_max,n)
     real(wp) :: v, p, K, G
     integer :: i
-    c = 0.0_wp
+    real(wp) :: c2
+    c = 0.0_wp; c2 = 0.0_wp
     do i = 1, size(rho)
       if (size(state, 1) < 3) then
         c = max(c, self%wave_speed(rho(i))); cycle
@@ -623,8 +714,9 @@ contains
       p = max(-(stress(1,i) + stress(2,i) + stress(3,i)) / 3.0_wp, self%p_min)
       K = v * p / self%kap
       G = self%shear_modulus(p, v)
-      c = max(c, sqrt((K + 4.0_wp * G / 3.0_wp) / rho(i)))
+      c2 = max(c2, (K + 4.0_wp * G / 3.0_wp) / rho(i))
     end do
+    c = max(c, sqrt(c2))
   end function cc_max_wave_speed
 
   !> Elastic energy estimate ψ = κ p'/v + q²/(6G(p')): the volumetric term is the work of the
@@ -655,10 +747,30 @@ contains
   function cc_failure_text(self) result(s)
     class(empm_camclay_t), intent(in) :: self !! material
     character(len=:), allocatable :: s        !! reason
-    associate (unused_ => self); end associate
-    s = 'the Modified Cam-Clay return mapping did not converge (the local Newton iteration '// &
-      'failed on the smallest substep, or the error-controlled integration needed more than '// &
-      'its cap of substeps: the strain increment of the step is too large, reduce dt), or the '// &
-      'step''s volume ratio left (1/e, e), or the initial specific volume from N was not positive'
+    character(len=160) :: b
+    integer :: why
+    why = 0
+    if (associated(self%failure)) why = self%failure%why
+    select case (why)
+    case (WHY_VOLUME)
+      write(b, '(a,es10.3,a)') 'its volume ratio exp(tr de) for tr de = ', self%failure%de, &
+        ' left (1/e, e) in one step'
+      s = 'the Modified Cam-Clay update refused the step: '//trim(b)// &
+        ' (a strain increment too large for a soil step: reduce dt or cfl)'
+    case (WHY_RESOLVE)
+      write(b, '(a,es10.3,a,es10.3,a)') 'p'' = ', self%failure%p, ' Pa, p''c = ', &
+        self%failure%pc, ' Pa'
+      s = 'the Modified Cam-Clay initial state is not valid: the specific volume from N is '// &
+        'not positive at '//trim(b)//' (check N, lambda, kappa, ocr and the initial stress)'
+    case (WHY_RETURN)
+      write(b, '(a,es10.3,a,es10.3,a,es10.3,a,es10.3)') 'p'' = ', self%failure%p, &
+        ' Pa, q = ', self%failure%q, ' Pa, p''c = ', self%failure%pc, ' Pa, |de| = ', &
+        self%failure%de
+      s = 'the Modified Cam-Clay return mapping did not converge at '//trim(b)// &
+        ' (the local Newton iteration failed on the smallest substep, or the substep cap '// &
+        'was reached: the strain increment of the step is too large, reduce dt or cfl)'
+    case default
+      s = 'the Modified Cam-Clay update failed'
+    end select
   end function cc_failure_text
 end module empm_material_camclay
