@@ -18,7 +18,8 @@ module empm_checkpoint
   use empm_h5, only: h5_group, h5_close_group, h5_write, h5_attr, h5_open_read, &
     h5_close_file, h5_exists, h5_dims, h5_read, h5_read_attr
   use empm_files, only: empm_rename, empm_remove
-  use empm_posix, only: empm_errno, empm_errno_text, empm_path_kind, PATH_REGULAR
+  use empm_posix, only: empm_errno, empm_errno_text, empm_write_reason, empm_path_kind, &
+    PATH_REGULAR
   use empm_version_info, only: empm_version
   use empm_parallel, only: empm_max_threads
   use empm_model, only: empm_model_t
@@ -176,8 +177,8 @@ contains
     end if
     if (ierr /= 0) then
       info = empm_remove(tmp)
-      call empm_raise(EMPM_ERR_IO, path//': writing the checkpoint failed: '//reason(oserr), &
-        err); return
+      call empm_raise(EMPM_ERR_IO, path//': writing the checkpoint failed: '// &
+        empm_write_reason(oserr), err); return
     end if
     ! Keep the last two: the current one becomes the previous, then the new one takes its
     ! place (a crash between the two renames leaves the previous one to restart from).
@@ -185,24 +186,14 @@ contains
       if (empm_rename(path, prev) /= 0) then
         oserr = empm_errno(); info = empm_remove(tmp)
         call empm_raise(EMPM_ERR_IO, path//': cannot keep it as '//prev//': '// &
-          reason(oserr), err); return
+          empm_write_reason(oserr), err); return
       end if
     end if
     if (empm_rename(tmp, path) /= 0) then
       oserr = empm_errno(); info = empm_remove(tmp)
-      call empm_raise(EMPM_ERR_IO, path//': cannot rename '//tmp//' to it: '//reason(oserr), &
-        err); return
+      call empm_raise(EMPM_ERR_IO, path//': cannot rename '//tmp//' to it: '// &
+        empm_write_reason(oserr), err); return
     end if
-  contains
-    function reason(code) result(r)
-      integer, intent(in) :: code
-      character(len=:), allocatable :: r
-      if (code > 0) then
-        r = empm_errno_text(code)
-      else
-        r = 'the HDF5 library reports an error'
-      end if
-    end function reason
   end subroutine empm_checkpoint_write
 
   !> Restore `model` (set up from the same case file), `hist` (initialised for it) and `state`

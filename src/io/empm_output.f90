@@ -30,7 +30,7 @@ module empm_output
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO, EMPM_ERR_INPUT
   use empm_files, only: empm_rename, empm_remove
   use empm_posix, only: empm_getpid, empm_process_alive, empm_path_kind, empm_errno, &
-    empm_errno_text, PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY
+    empm_errno_text, empm_write_reason, PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY
   use empm_version_info, only: empm_version
   use empm_model, only: empm_model_t
   use empm_material, only: STATE_NAME_LEN
@@ -195,7 +195,7 @@ contains
     if (ierr /= 0) then
       info = empm_remove(tmp)
       call empm_raise(EMPM_ERR_IO, path//': writing the HDF5 output '//tmp//' failed: '// &
-        os_reason(oserr), err); return
+        empm_write_reason(oserr), err); return
     end if
     xmf = empm_xdmf_path(path)
     xtmp = empm_partial_name(xmf)
@@ -203,31 +203,21 @@ contains
     if (ierr /= 0) then
       info = empm_remove(tmp); info = empm_remove(xtmp)
       call empm_raise(EMPM_ERR_IO, path//': cannot write the XDMF file '//xtmp//': '// &
-        os_reason(oserr), err)
+        empm_write_reason(oserr), err)
       return
     end if
     if (empm_rename(tmp, path) /= 0) then
       oserr = empm_errno()
       info = empm_remove(tmp); info = empm_remove(xtmp)
       call empm_raise(EMPM_ERR_IO, path//': cannot rename '//tmp//' to '//path//': '// &
-        os_reason(oserr), err); return
+        empm_write_reason(oserr), err); return
     end if
     if (empm_rename(xtmp, xmf) /= 0) then
       oserr = empm_errno()
       info = empm_remove(xtmp)
       call empm_raise(EMPM_ERR_IO, path//': cannot rename '//xtmp//' to '//xmf//': '// &
-        os_reason(oserr), err)
+        empm_write_reason(oserr), err)
     end if
-  contains
-    function os_reason(code) result(r)
-      integer, intent(in) :: code
-      character(len=:), allocatable :: r
-      if (code > 0) then
-        r = empm_errno_text(code)
-      else
-        r = 'the HDF5 library reports an error'
-      end if
-    end function os_reason
   end subroutine empm_write_results
 
   subroutine write_state(g, pts, ierr)

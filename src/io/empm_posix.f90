@@ -9,7 +9,7 @@ module empm_posix
   implicit none
   private
   public :: empm_getpid, empm_process_alive, empm_path_kind, empm_errno, empm_errno_text, &
-            empm_ignore_sigxfsz, empm_catch_stop_signals, empm_stop_signal
+            empm_ignore_sigxfsz, empm_catch_stop_signals, empm_stop_signal, empm_write_reason
   public :: PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY, PATH_OTHER
 
   integer, parameter :: PATH_MISSING = 0   !! nothing at the path (or it cannot be examined)
@@ -127,6 +127,18 @@ contains
       text(k:k) = s(k)
     end do
   end function empm_errno_text
+
+  !> Why a write failed, for a message: the system's text for `code` (an errno), or, when the
+  !> system gave none (0), that the HDF5 library reported the error.
+  function empm_write_reason(code) result(r)
+    integer, intent(in) :: code            !! errno after the failed call, or 0
+    character(len=:), allocatable :: r     !! the reason
+    if (code > 0) then
+      r = empm_errno_text(code)
+    else
+      r = 'the HDF5 library reports an error'
+    end if
+  end function empm_write_reason
 
   !> Ignore SIGXFSZ, so that a write beyond the file-size limit (`ulimit -f`) fails with EFBIG
   !> and is reported as an I/O error instead of killing the process (the Fortran run-time

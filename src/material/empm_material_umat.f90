@@ -433,6 +433,27 @@ contains
       self%why = code
     end subroutine fail
 
+    ! What a UMAT call returned: WHY_NSTATV when it wrote past STATEV(NSTATV) (the guards,
+    ! checked bit for bit in one branch), WHY_NONFINITE for a non-finite stress, WHY_PNEWDT
+    ! when it asked for a smaller increment, else 0.
+    integer function verdict(sg, pnew) result(why)
+      real(wp), intent(in) :: sg(6), pnew
+      integer(int64) :: g
+      integer :: i
+      g = 0
+      do i = nsv + 1, nsv + NGUARD
+        g = ior(g, ieor(transfer(statev(i), GUARD_BITS), GUARD_BITS))
+      end do
+      why = 0
+      if (g /= 0) then
+        why = WHY_NSTATV
+      else if (.not. all(finite(sg(1:ntens)))) then
+        why = WHY_NONFINITE
+      else if (pnew < 1.0_wp) then
+        why = WHY_PNEWDT
+      end if
+    end function verdict
+
     ! One particle's step in one increment (k = 1 of `increments`, with the same arithmetic),
     ! writing the particle only when the UMAT's result is accepted; why and pnewdt as there.
     subroutine single(Lp, a3, c, sp, ep, Fp, stp, why, pnewdt)
@@ -442,7 +463,6 @@ contains
       integer, intent(out) :: why
       real(wp), intent(out) :: pnewdt
       real(wp) :: drot(3,3), F1(3,3), sig(6), stran(6), dstran(6), s(6), e(6)
-      integer(int64) :: g
       integer :: i
       logical :: spin
       real(wp) :: ct, st
@@ -504,23 +524,8 @@ contains
           nstatv, props, nprops, coords, drot, pnewdt, celent, F1, F1, noel, npt, &
           layer, kspt, kstep, kinc, int(len(cmname), c_size_t))
       end if
-      ! Guards bit for bit, all at once (one branch).
-      g = 0
-      do i = nsv + 1, nsv + NGUARD
-        g = ior(g, ieor(transfer(statev(i), GUARD_BITS), GUARD_BITS))
-      end do
-      if (g /= 0) then
-        why = WHY_NSTATV; return
-      end if
-      do i = 1, ntens
-        if (.not. finite(sig(i))) then
-          why = WHY_NONFINITE; return
-        end if
-      end do
-      if (pnewdt < 1.0_wp) then
-        why = WHY_PNEWDT; return
-      end if
-      why = 0
+      why = verdict(sig, pnewdt)
+      if (why /= 0) return
       call from_abaqus(ntens, sig, sp)
       ep = e + de
       if (self%uses_dfgrd) Fp = F1
@@ -577,19 +582,8 @@ contains
           dstran, time, dtime, temp, dtemp, predef, dpred, cmname, ndi, nshr, ntens, &
           nstatv, props, nprops, coords, drot, pnewdt, celent, F0, F1, noel, npt, &
           layer, kspt, kstep, kinc, int(len(cmname), c_size_t))
-        do i = nsv + 1, nsv + NGUARD
-          if (transfer(statev(i), GUARD_BITS) /= GUARD_BITS) then
-            why = WHY_NSTATV; return
-          end if
-        end do
-        do i = 1, ntens
-          if (.not. finite(sig(i))) then
-            why = WHY_NONFINITE; return
-          end if
-        end do
-        if (pnewdt < 1.0_wp) then
-          why = WHY_PNEWDT; return
-        end if
+        why = verdict(sig, pnewdt)
+        if (why /= 0) return
         call from_abaqus(ntens, sig, s)
         e = e + dsub
         F0 = F1

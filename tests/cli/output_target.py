@@ -59,9 +59,10 @@ def check_complete(path):
             fail(f"{path}: history ends at t = {t[-1]}")
 
 
-def concurrent(empm, cases, work):
-    case = os.path.join(cases, "long.nml")  # about 1 s in a Debug build
-    out = "same.h5"
+def start_long_run(empm, cases, work, out, what):
+    """Start long.nml (about 1 s in a Debug build) writing `out`; return once it holds the
+    output's lock, i.e. after its up-front checks."""
+    case = os.path.join(cases, "long.nml")
     a = subprocess.Popen([empm, "run", case, "-o", out], cwd=work, stdout=subprocess.PIPE,
                          stderr=subprocess.PIPE, text=True)
     lock = os.path.join(work, out + ".lock")
@@ -69,7 +70,13 @@ def concurrent(empm, cases, work):
     while not os.path.exists(lock) and a.poll() is None and time.time() - t0 < 30:
         time.sleep(0.005)
     if a.poll() is not None:
-        fail("the first run ended before the second could start (case too short)")
+        fail(f"the run ended before {what} (case too short)")
+    return a
+
+
+def concurrent(empm, cases, work):
+    case, out = os.path.join(cases, "long.nml"), "same.h5"
+    a = start_long_run(empm, cases, work, out, "the second could start")
     b = run(empm, [case, "-o", out], work)
     a_out, a_err = a.communicate(timeout=120)
     print(f"first run -> status {a.returncode}\n{a_out}{a_err}")
@@ -163,16 +170,8 @@ def disk_full(empm, cases, work):
 
 
 def xdmf_fails(empm, cases, work):
-    case = os.path.join(cases, "long.nml")  # about 1 s in a Debug build
     out, xmf = "xf.h5", os.path.join(work, "xf.xmf")
-    a = subprocess.Popen([empm, "run", case, "-o", out], cwd=work, stdout=subprocess.PIPE,
-                         stderr=subprocess.PIPE, text=True)
-    lock = os.path.join(work, out + ".lock")
-    t0 = time.time()
-    while not os.path.exists(lock) and a.poll() is None and time.time() - t0 < 30:
-        time.sleep(0.005)
-    if a.poll() is not None:
-        fail("the run ended before the folder could be made (case too short)")
+    a = start_long_run(empm, cases, work, out, "the folder could be made")
     # After the run's up-front checks: the XDMF file's final rename must fail.
     os.mkdir(xmf)
     with open(os.path.join(xmf, "keep"), "w") as f:
