@@ -10,7 +10,7 @@ module empm
   use empm_kinds, only: empm_wp => wp, empm_pi => pi
   use empm_version_info, only: empm_version
   use empm_error, only: empm_error_t, EMPM_OK, EMPM_ERR_USAGE, EMPM_ERR_INPUT, &
-                        EMPM_ERR_RUNTIME, EMPM_ERR_IO
+                        EMPM_ERR_RUNTIME, EMPM_ERR_IO, EMPM_ERR_INTERRUPTED
   use empm_tensor, only: empm_voigt_to_mat => voigt_to_mat, empm_mat_to_voigt => mat_to_voigt
   use empm_grid, only: empm_grid_t
   use empm_nodes, only: empm_nodes_t
@@ -37,14 +37,16 @@ module empm
   use empm_namelist, only: empm_group_t, empm_group_from_text, empm_kv
   use empm_family, only: empm_family_t
   use empm_history, only: empm_history_t, empm_snapshot_t
-  use empm_solver, only: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
+  use empm_solver, only: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies, &
+    empm_run_hook_t, empm_solver_state_t
   use empm_output, only: empm_write_results, empm_output_meta_t
   use empm_driver, only: empm_run_case
   implicit none
   private
   ! Kinds, version, errors
   public :: empm_wp, empm_pi, empm_version, empm_error_t
-  public :: EMPM_OK, EMPM_ERR_USAGE, EMPM_ERR_INPUT, EMPM_ERR_RUNTIME, EMPM_ERR_IO
+  public :: EMPM_OK, EMPM_ERR_USAGE, EMPM_ERR_INPUT, EMPM_ERR_RUNTIME, EMPM_ERR_IO, &
+            EMPM_ERR_INTERRUPTED
   public :: empm_voigt_to_mat, empm_mat_to_voigt
   ! Discretisation
   public :: empm_grid_t, empm_nodes_t, empm_particles_t
@@ -65,5 +67,6 @@ module empm
   public :: EMPM_PARAM_LOGICAL, empm_group_t, empm_group_from_text, empm_kv
   public :: empm_history_t, empm_snapshot_t
   public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
+  public :: empm_run_hook_t, empm_solver_state_t
   public :: empm_write_results, empm_output_meta_t, empm_run_case
 end module empm
