@@ -78,6 +78,8 @@ contains
     call reg%add_shape(empm_shape_ugimp_t())
     call reg%add_shape(empm_shape_bspline_t(order=2))
     call reg%add_shape(empm_shape_bspline_t(order=3))
+    call reg%add_shape(empm_shape_bspline_t(order=2, clamped=.true.))
+    call reg%add_shape(empm_shape_bspline_t(order=3, clamped=.true.))
     call reg%add_shape(empm_shape_lme_t())
     call reg%add_material(empm_linear_elastic_t())
     call reg%add_material(empm_neohookean_t())

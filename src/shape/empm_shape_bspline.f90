@@ -13,9 +13,18 @@
 !> Near the grid boundary the uniform B-spline needs nodes outside the grid: evaluation then
 !> returns `SHAPE_SUPPORT_CLIPPED`: for points closer than h/2 (quadratic) or h (cubic) to a
 !> grid face. The user must pad the grid by enough cells that material stays at least that far
-!> from every face (one padding cell suffices for both). Boundary-modified B-splines are
-!> future work. An `order` other than 2 or 3 gives `max_nodes = 0` and
-!> `SHAPE_TOO_MANY_NODES` (no storage can hold an undefined support).
+!> from every face (one padding cell suffices for both). An `order` other than 2 or 3 gives
+!> `max_nodes = 0` and `SHAPE_TOO_MANY_NODES` (no storage can hold an undefined support).
+!>
+!> **Clamped** variants (`bspline2_clamped`, `bspline3_clamped`): in each direction the knot
+!> vector is the uniform one in the interior and repeated p + 1 times at the grid's first and
+!> last node (quadratic, in cell units: 0,0,0, 3/2, 5/2, …, n − 3/2, n,n,n; cubic: 0,0,0,0, 2, 3,
+!> …, n − 2, n,n,n,n), one function per node. The functions of nodes at least p + 1 cells from a
+!> face are the uniform ones; the face node's function is 1 on the face (interpolatory there,
+!> so a fixed face node imposes v = 0 exactly, with no nodes outside the body's boundary); the
+!> basis is a partition of unity and reproduces linear fields on the whole grid box, with no
+!> padding. Points within 2p cells of a face are evaluated by the Cox–de Boor recursion,
+!> the others by the uniform formulas.
 module empm_shape_bspline
   use empm_kinds, only: wp
   use empm_grid, only: empm_grid_t
@@ -29,9 +38,10 @@ module empm_shape_bspline
   private
   public :: empm_shape_bspline_t, shape_bspline_kernel
 
-  !> Uniform B-spline shape functions of degree `order` (2 or 3).
+  !> B-spline shape functions of degree `order` (2 or 3), uniform or clamped at the grid faces.
   type, extends(empm_shape_t) :: empm_shape_bspline_t
-    integer :: order = 3 !! polynomial degree: 2 (quadratic) or 3 (cubic)
+    integer :: order = 3          !! polynomial degree: 2 (quadratic) or 3 (cubic)
+    logical :: clamped = .false.  !! knots repeated at the grid faces (no padding needed)
   contains
     procedure :: max_nodes => bspline_max_nodes
     procedure :: eval_point => bspline_eval_point
@@ -65,6 +75,7 @@ contains
     case (3); s = 'bspline3'
     case default; s = 'bspline?'
     end select
+    if (self%clamped) s = s//'_clamped'
   end function bspline_family
 
   !> One-line description of the family.
@@ -78,14 +89,21 @@ contains
                   'one padding cell'
     case default; s = 'uniform B-splines of an unsupported order'
     end select
+    if (self%clamped) then
+      select case (self%order)
+      case (2); s = 'quadratic B-splines clamped at the grid faces (knots repeated there): '// &
+                    'interpolatory on the faces, no padding'
+      case (3); s = 'cubic B-splines clamped at the grid faces (knots repeated there): '// &
+                    'interpolatory on the faces, no padding'
+      end select
+    end if
   end function bspline_summary
 
   !> Padding cells: 1 (the uniform spline needs nodes beyond the grid within h/2 (quadratic) or
   !> h (cubic) of a face: SHAPE_SUPPORT_CLIPPED).
   pure integer function bspline_padding_cells(self) result(n)
     class(empm_shape_bspline_t), intent(in) :: self !! shape family
-    associate (unused_ => self); end associate
-    n = 1
+    n = merge(0, 1, self%clamped)
   end function bspline_padding_cells
 
   !> Family identifier: "bspline2" or "bspline3" ("bspline?" for an unsupported order).
@@ -97,6 +115,7 @@ contains
     case (3); s = 'bspline3'
     case default; s = 'bspline?'
     end select
+    if (self%clamped) s = s//'_clamped'
   end function bspline_name
 
   !> Values and gradients at one point (`lp` and `lam` are not used by this family).
@@ -112,7 +131,7 @@ contains
     real(wp), intent(out) :: dN(:,:)                !! gradients (ndim, :)
     integer, intent(out) :: info                    !! SHAPE_OK or a SHAPE_* failure code
     associate (unused_lp_ => lp, unused_lam_ => lam); end associate
-    call shape_bspline_kernel(self%order, grid, x, nn, node, N, dN, info)
+    call shape_bspline_kernel(self%order, grid, x, nn, node, N, dN, info, self%clamped)
   end subroutine bspline_eval_point
 
   !> Values and gradients at particles 1..pts%np; stops at the first failing particle.
@@ -132,7 +151,7 @@ contains
     !$omp   private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
       call shape_bspline_kernel(self%order, grid, pts%x(:, p), basis%nn(p), basis%node(:, p), &
-                                basis%N(:, p), basis%dN(:, :, p), pinfo)
+                                basis%N(:, p), basis%dN(:, :, p), pinfo, self%clamped)
       if (pinfo /= SHAPE_OK) call shape_keep_first_failure(p, pinfo, ibad, info)
     end do
     !$omp end parallel do
@@ -141,7 +160,7 @@ contains
 
   !> B-spline shape functions of degree `order` at one point; only nodes with a nonzero value
   !> are returned, in increasing index order.
-  pure subroutine shape_bspline_kernel(order, grid, x, nn, node, N, dN, info)
+  pure subroutine shape_bspline_kernel(order, grid, x, nn, node, N, dN, info, clamped)
     integer, intent(in) :: order          !! degree: 2 or 3
     type(empm_grid_t), intent(in) :: grid !! background grid
     real(wp), intent(in) :: x(:)          !! point (ndim)
@@ -150,7 +169,9 @@ contains
     real(wp), intent(out) :: N(:)         !! values
     real(wp), intent(out) :: dN(:,:)      !! gradients (ndim, :)
     integer, intent(out) :: info          !! SHAPE_OK or a SHAPE_* failure code (see module)
+    logical, intent(in), optional :: clamped !! knots repeated at the grid faces (default no)
     integer :: m(3), base(3), d
+    logical :: clamp
     real(wp) :: w(SHAPE_TP_MAXM, 3), g(SHAPE_TP_MAXM, 3)
     nn = 0
     if (order /= 2 .and. order /= 3) then
@@ -162,8 +183,20 @@ contains
     if (.not. grid%inside(x)) then
       info = SHAPE_OUTSIDE_GRID; return
     end if
+    clamp = .false.
+    if (present(clamped)) clamp = clamped
     call shape_tp_init(m, base, w, g)
     do d = 1, grid%ndim
+      if (clamp) then
+        if (grid%ncell(d) < 2 * order) then
+          info = SHAPE_SUPPORT_CLIPPED; return  ! too few cells for the clamped knots
+        end if
+        if ((x(d) - grid%origin(d)) * grid%inv_h(d) < real(2 * order, wp) .or. &
+            (x(d) - grid%origin(d)) * grid%inv_h(d) > real(grid%ncell(d) - 2 * order, wp)) then
+          call clamped_1d(order, grid, d, x(d), m(d), base(d), w(:, d), g(:, d))
+          cycle
+        end if
+      end if
       call bspline_1d(order, grid, d, x(d), m(d), base(d), w(:, d), g(:, d), info)
       if (info /= SHAPE_OK) return
     end do
@@ -223,4 +256,78 @@ contains
     end do
     info = SHAPE_OK
   end subroutine bspline_1d
+  !> 1D factors of the clamped B-splines along direction `d` by the Cox–de Boor recursion
+  !> (values and first derivatives of the p + 1 functions of the knot span holding the point),
+  !> with the functions at the ends of the list whose value and slope are both zero dropped.
+  pure subroutine clamped_1d(p, grid, d, xd, m, base, w, g)
+    integer, intent(in) :: p              !! degree: 2 or 3
+    type(empm_grid_t), intent(in) :: grid !! background grid
+    integer, intent(in) :: d              !! direction
+    real(wp), intent(in) :: xd            !! coordinate of the point (inside the grid)
+    integer, intent(out) :: m             !! number of nodes
+    integer, intent(out) :: base          !! 0-based index of the first node
+    real(wp), intent(out) :: w(:)         !! values
+    real(wp), intent(out) :: g(:)         !! derivatives with respect to x_d
+    real(wp) :: s, left(3), right(3), Nd(0:3, 0:3), saved, tmp, a(0:3), ih
+    integer :: n, k, j, r, first, last
+    n = grid%ncell(d)
+    ih = grid%inv_h(d)
+    s = min(max((xd - grid%origin(d)) * ih, 0.0_wp), real(n, wp))
+    ! The span k: knot(k) <= s < knot(k+1), the last non-empty span for s = n.
+    k = p
+    do while (k < n .and. knot(k + 1) <= s)
+      k = k + 1
+    end do
+    ! Values of degrees 0..p (The NURBS Book, A2.2), the table kept for the derivative.
+    Nd = 0.0_wp
+    Nd(0, 0) = 1.0_wp
+    do j = 1, p
+      left(j) = s - knot(k + 1 - j)
+      right(j) = knot(k + j) - s
+      saved = 0.0_wp
+      do r = 0, j - 1
+        ! Lower triangle: knot differences; upper: the basis values.
+        Nd(j, r) = right(r + 1) + left(j - r)
+        tmp = Nd(r, j - 1) / Nd(j, r)
+        Nd(r, j) = saved + right(r + 1) * tmp
+        saved = left(j - r) * tmp
+      end do
+      Nd(j, j) = saved
+    end do
+    ! First derivatives: p (N_{i,p-1}/(t_{i+p} − t_i) − N_{i+1,p-1}/(t_{i+p+1} − t_{i+1})).
+    do r = 0, p
+      a(r) = 0.0_wp
+      if (r >= 1) a(r) = a(r) + Nd(r - 1, p - 1) / Nd(p, r - 1)
+      if (r <= p - 1) a(r) = a(r) - Nd(r, p - 1) / Nd(p, r)
+      a(r) = real(p, wp) * a(r)
+    end do
+    ! Drop only functions whose value and slope both vanish (on a face a neighbour's value is
+    ! 0 but its slope is not: the gradients must still sum to zero).
+    first = 0; last = p
+    do while (first < last .and. Nd(first, p) == 0.0_wp .and. a(first) == 0.0_wp)
+      first = first + 1
+    end do
+    do while (last > first .and. Nd(last, p) == 0.0_wp .and. a(last) == 0.0_wp)
+      last = last - 1
+    end do
+    m = last - first + 1
+    base = k - p + first
+    do r = first, last
+      w(r - first + 1) = Nd(r, p)
+      g(r - first + 1) = a(r) * ih
+    end do
+  contains
+    ! Knot i of the clamped vector in cell units: p + 1 zeros, the uniform interior knots (cell
+    ! midpoints for p = 2, nodes for p = 3), p + 1 values n.
+    pure real(wp) function knot(i)
+      integer, intent(in) :: i
+      if (i <= p) then
+        knot = 0.0_wp
+      else if (i >= n + 1) then
+        knot = real(n, wp)
+      else
+        knot = real(i, wp) - 0.5_wp * real(p + 1, wp)
+      end if
+    end function knot
+  end subroutine clamped_1d
 end module empm_shape_bspline
