@@ -256,6 +256,7 @@ contains
     end do
     info = SHAPE_OK
   end subroutine bspline_1d
+
   !> 1D factors of the clamped B-splines along direction `d` by the Cox–de Boor recursion
   !> (values and first derivatives of the p + 1 functions of the knot span holding the point),
   !> with the functions at the ends of the list whose value and slope are both zero dropped.
