@@ -8,6 +8,7 @@ module empm_solver
                         EMPM_ERR_RUNTIME, EMPM_ERR_USAGE, EMPM_ERR_INTERRUPTED
   use empm_strings, only: str, join
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK, STEP_SHAPE_FAILED
+  use empm_loads, only: RAMP_NONE
   use empm_integrator, only: empm_integrator_t
   use empm_particles, only: empm_particles_t
   use empm_history, only: empm_history_t
@@ -179,6 +180,15 @@ contains
     type(empm_solver_state_t), intent(in), optional :: resume !! continue a restored run
     type(empm_particles_t) :: good
     type(empm_solver_state_t) :: sst
+    ! The last good state is kept every KEEP_EVERY steps only (a copy of every particle array
+    ! each step cost as much as a linear step): a guard stop restores it and replays the
+    ! steps since with their recorded time steps, which gives the state before the failing
+    ! step bitwise (the step is deterministic for a given number of threads).
+    integer, parameter :: KEEP_EVERY = 64
+    real(wp) :: dts(KEEP_EVERY), t_prev
+    real(wp), allocatable :: xprev(:,:)
+    integer :: nrep
+    logical :: ramping
     real(wp), allocatable :: tlam(:,:,:)
     real(wp) :: residual0
     integer(int64) :: clock_ckpt
@@ -243,6 +253,10 @@ contains
     ! Plain lines (logs, pipes) are written when t passes the next tenth of the run.
     t_report = model%t + 0.1_wp * (cfg%t_end - model%t)
     call system_clock(clock0, rate); clock_last = clock0; clock_ckpt = clock0
+    nrep = KEEP_EVERY ! a copy before the first step
+    ! The work of a time-varying gravity needs the positions before each step.
+    ramping = model%loads%ramp /= RAMP_NONE
+    if (ramping) allocate(xprev(model%grid%ndim, model%pts%np))
 
     do while (model%t < cfg%t_end * (1.0_wp - 1.0e-12_wp))
       if (model%step >= cfg%max_steps) then
@@ -264,9 +278,15 @@ contains
       if (isnap <= nsnap) t_next_snap = min(cfg%t_end, cfg%snapshot_times(isnap))
       if (model%t + dt > t_next_snap * (1.0_wp - 1.0e-12_wp)) dt = t_next_snap - model%t
 
-      call good%copy_state_from(model%pts)
-      t_good = model%t; step_good = model%step
+      if (nrep == KEEP_EVERY) then
+        call good%copy_state_from(model%pts)
+        call save_tractions()
+        t_good = model%t; step_good = model%step; nrep = 0
+      end if
+      t_prev = model%t
+      if (ramping) xprev = model%pts%x(:, 1:model%pts%np)
       call integ%step(model, dt, stat)
+      nrep = nrep + 1; dts(nrep) = dt
       model%step = model%step + 1
       if (stat%code /= STEP_OK) then
         msg = describe_status(stat)
@@ -352,8 +372,11 @@ contains
         if (allocated(model%loads%tractions(k)%lam)) &
           n = max(n, size(model%loads%tractions(k)%lam, 2))
       end do
-      allocate(tlam(model%grid%ndim, n, size(model%loads%tractions)))
-      tlam = 0.0_wp
+      ! Allocated once (this runs in the time loop too, at every kept state).
+      if (.not. allocated(tlam)) then
+        allocate(tlam(model%grid%ndim, n, size(model%loads%tractions)))
+        tlam = 0.0_wp
+      end if
       do k = 1, size(model%loads%tractions)
         associate (tr => model%loads%tractions(k))
           if (allocated(tr%lam)) tlam(:, 1:size(tr%lam, 2), k) = tr%lam
@@ -375,11 +398,11 @@ contains
     subroutine add_gravity_work()
       real(wp) :: g0(3), g1(3)
       integer :: d, np
-      g0 = model%loads%gravity_at(t_good); g1 = model%loads%gravity_at(model%t)
-      if (all(g0 == g1)) return
+      g0 = model%loads%gravity_at(t_prev); g1 = model%loads%gravity_at(model%t)
+      if (all(g0 == g1) .or. .not. ramping) return
       d = model%grid%ndim; np = model%pts%np
       st%work_gravity = st%work_gravity - sum(model%pts%m(1:np) * matmul(g1(1:d) - g0(1:d), &
-        0.5_wp * (good%x(:, 1:np) + model%pts%x(:, 1:np))))
+        0.5_wp * (xprev(:, 1:np) + model%pts%x(:, 1:np))))
     end subroutine add_gravity_work
 
     ! The statistics of the run so far (the model holds the last good state).
@@ -402,9 +425,20 @@ contains
       end do
     end subroutine skip_past_snapshots
 
+    ! Back to the state before the failing step: the kept state, then the steps since it
+    ! replayed with their time steps (all but the last, which failed).
     subroutine restore()
+      type(empm_step_status_t) :: rs
+      integer :: i
       call model%pts%copy_state_from(good)
+      call restore_tractions()
       model%t = t_good; model%step = step_good
+      do i = 1, nrep - 1
+        call integ%step(model, dts(i), rs)
+        if (rs%code /= STEP_OK) exit ! cannot happen for a deterministic step
+        model%step = model%step + 1
+        model%t = model%t + dts(i)
+      end do
     end subroutine restore
 
     ! The run-time error: the text already names the step (and the particle or node); the

@@ -16,6 +16,9 @@
             incomplete) written; the restart completes bitwise.
   seconds   checkpoints by wall time (checkpoint_seconds): written during the run, and the
             restart from the one before the last is bitwise.
+  guard     a guard stop after more steps than the kept copy spans (the solver keeps the state
+            every 64 steps and replays the steps since): the last good state written equals,
+            bitwise, the state of the same run stopped before the failing step by max_steps.
   refuse    a checkpoint of another case file (one value changed), of another version, a
             damaged one, a results file and a missing file: each refused with status 2 and
             the reason.
@@ -275,6 +278,46 @@ def seconds(empm, work):
     restart_equals(empm, work, "wall", text, ckpt="any")
 
 
+def guard(empm, work):
+    # A bar thrown towards the end of its grid: it leaves it after about 150 steps.
+    text = """&grid ndim = 1, h = 0.05, cells = 40 /
+&shape family = '{shape}' /
+&material name = 'm', model = 'linear_elastic', E = 100.0, density = 1.0 /
+&particles material = 'm', geometry = 'interval', lo = 0.0, hi = 1.0, ppc = 2, velocity = 0.1 /
+&integrator scheme = '{scheme}', t_end = 100.0{cap} /
+&probe name = 'end', point = 1.0 /
+"""
+    for shape, scheme in (("linear", "pc_newmark"), ("lme_g3", "musl")):
+        case = os.path.join(work, f"g_{shape}.nml")
+        with open(case, "w") as f:
+            f.write(text.format(shape=shape, scheme=scheme, cap=""))
+        p = run(empm, [case, "-o", f"g_{shape}.h5"], work, check=3)
+        if "left the grid" not in p.stderr:
+            fail(f"{shape}: expected a particle leaving the grid: {p.stderr}")
+        with h5py.File(os.path.join(work, f"g_{shape}.h5"), "r") as f:
+            t_last = float(f["history/time"][-1])
+            steps = int(f["final"].attrs["step"]) if "step" in f["final"].attrs else None
+        if steps is None:
+            # The step of the last good state: from the failing step in the message.
+            steps = int(p.stderr.split("step ")[1].split(":")[0]) - 1
+        if steps <= 64:
+            fail(f"{shape}: the guard tripped at step {steps + 1}, within the first kept copy")
+        capped = os.path.join(work, f"c_{shape}.nml")
+        with open(capped, "w") as f:
+            f.write(text.format(shape=shape, scheme=scheme, cap=f", max_steps = {steps}"))
+        p2 = run(empm, [capped, "-o", f"c_{shape}.h5"], work, check=3)
+        if "step cap" not in p2.stderr:
+            fail(f"{shape}: the capped run did not stop at its cap: {p2.stderr}")
+        a, b = os.path.join(work, f"g_{shape}.h5"), os.path.join(work, f"c_{shape}.h5")
+        with h5py.File(a, "r") as fa, h5py.File(b, "r") as fb:
+            bad = [k for k in fa["final"] if isinstance(fa["final"][k], h5py.Dataset)
+                   and not np.array_equal(fa["final"][k][()], fb["final"][k][()])]
+        print(f"guard {shape}/{scheme}: last good state after step {steps} (t = {t_last}); "
+              f"{len(bad)} final datasets differ from the capped run")
+        if bad:
+            fail(f"{shape}: the last good state differs from the state at step {steps}: {bad}")
+
+
 def refuse(empm, work):
     case = os.path.join(work, "r.nml")
     text = CASE_1D.format(shape="linear", scheme="pc_newmark")
@@ -324,7 +367,8 @@ def main():
     shutil.rmtree(work, ignore_errors=True)
     os.makedirs(work)
     {"matrix": matrix, "threads": threads, "geotech": geotech, "sigkill": sigkill,
-     "signals": signals, "seconds": seconds, "refuse": refuse}[scenario](empm, work)
+     "signals": signals, "seconds": seconds, "guard": guard,
+     "refuse": refuse}[scenario](empm, work)
     print("PASS")
 
 
