@@ -22,7 +22,6 @@ module empm_driver
     character(len=:), allocatable :: path       ! OUT.ckpt.h5
     character(len=:), allocatable :: prev       ! OUT.ckpt.prev.h5
     character(len=:), allocatable :: case_text  ! the case file's text
-    logical :: written = .false.                ! a checkpoint was written
   contains
     procedure :: checkpoint => hook_checkpoint
     procedure :: stop_requested => hook_stop
@@ -37,7 +36,6 @@ contains
     type(empm_solver_state_t), intent(in) :: state
     type(empm_error_t), intent(out) :: err
     call empm_checkpoint_write(self%path, self%prev, model, hist, state, self%case_text, err)
-    if (err%code == EMPM_OK) self%written = .true.
   end subroutine hook_checkpoint
 
   integer function hook_stop(self) result(sig)

@@ -171,6 +171,7 @@ contains
     integer, intent(out) :: info          !! SHAPE_OK or a SHAPE_* failure code (see module)
     logical, intent(in), optional :: clamped !! knots repeated at the grid faces (default no)
     integer :: m(3), base(3), d
+    real(wp) :: sd
     logical :: clamp
     real(wp) :: w(SHAPE_TP_MAXM, 3), g(SHAPE_TP_MAXM, 3)
     nn = 0
@@ -191,8 +192,8 @@ contains
         if (grid%ncell(d) < 2 * order) then
           info = SHAPE_SUPPORT_CLIPPED; return  ! too few cells for the clamped knots
         end if
-        if ((x(d) - grid%origin(d)) * grid%inv_h(d) < real(2 * order, wp) .or. &
-            (x(d) - grid%origin(d)) * grid%inv_h(d) > real(grid%ncell(d) - 2 * order, wp)) then
+        sd = (x(d) - grid%origin(d)) * grid%inv_h(d)
+        if (sd < real(2 * order, wp) .or. sd > real(grid%ncell(d) - 2 * order, wp)) then
           call clamped_1d(order, grid, d, x(d), m(d), base(d), w(:, d), g(:, d))
           cycle
         end if
