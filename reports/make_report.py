@@ -29,6 +29,18 @@ def h5(path):
 def fmt(x):
     return "n/a" if x is None else f"{x:.3g}"
 
+def order_bound(c):
+    """The bounds a convergence group asserts: orders, finest error, or a known failure's."""
+    if c.get("expected_failure"):
+        return f"known failure: < {fmt(c['expect_order_below'])}"
+    bound = f"≥ {fmt(c['min_order'])}" if c.get("min_order", -1e300) > -99 else ""
+    if "max_order" in c:
+        bound += (", " if bound else "") + f"≤ {fmt(c['max_order'])}"
+    if "max_error" in c:
+        bound += (", " if bound else "") + f"finest error ≤ {fmt(c['max_error'])}"
+    return bound
+
+
 
 def savefig(fig, name):
     fig.tight_layout()
@@ -54,11 +66,7 @@ def summary_table(s):
             rows.append(f"| `{c['id']}` | {m} | {fmt(v)} | {bound} | "
                         f"{result(c) if i == 0 else ''} |")
     for c in s["convergence"]:
-        bound = f"≥ {fmt(c['min_order'])}" if c.get("min_order", -1e300) > -99 else ""
-        if "max_order" in c:
-            bound += (", " if bound else "") + f"≤ {fmt(c['max_order'])}"
-        if c.get("expected_failure"):
-            bound = f"known failure: < {fmt(c['expect_order_below'])}"
+        bound = order_bound(c)
         rows.append(f"| `{c['id']}` | order of {c['metric']} | {fmt(c['observed_order'])} | "
                     f"{bound} | {result(c)} |")
     return "\n".join(rows)
@@ -121,11 +129,7 @@ def convergence_section(conv, name, title, exact):
             allx += list(h); ally += list(e)
         else:
             orders = []
-        bound = f"≥ {fmt(c['min_order'])}" if c.get("min_order", -1e300) > -99 else ""
-        if "max_order" in c:
-            bound += (", " if bound else "") + f"≤ {fmt(c['max_order'])}"
-        if c.get("expected_failure"):
-            bound = f"known failure: < {fmt(c['expect_order_below'])}"
+        bound = order_bound(c)
         rows.append(f"| `{c['id']}` | {', '.join(fmt(x) for x in h)} | "
                     f"{', '.join(fmt(x) for x in e)} | {', '.join(f'{o:.2f}' for o in orders)} | "
                     f"{fmt(c.get('fitted_order'))} | {bound} | {result(c)} |")

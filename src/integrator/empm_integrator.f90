@@ -17,10 +17,12 @@ module empm_integrator
   use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID
   use empm_material, only: empm_material_ctx_t
   use empm_shape, only: BASIS_Q4, basis_q4_weights
-  use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds
+  use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds, &
+                           EMPM_OMP_MIN_PARTICLES
   implicit none
   private
   public :: empm_integrator_t, eval_basis, map_velocity, update_stress, initial_acceleration
+  public :: carry_basis, particle_axpy
 
   !> Particles per material call in [[update_stress]]: their L, F, strain and stress fit in
   !> the L1 cache together.
@@ -47,6 +49,14 @@ module empm_integrator
                                          !! row (ndim, np)
     type(empm_p2g_work_t) :: p2g         !! per-thread P2G buffers (sized in `prepare`)
     type(empm_phase_timer_t) :: timer    !! wall time per phase of the step, Newton iterations
+    logical :: basis_ready = .false.     !! model%basis is at the particles' current positions
+                                         !! (evaluated at the end of the last step by
+                                         !! [[carry_basis]]): the next step reuses it
+    logical :: carry = .false.           !! the scheme carries the basis of x^{n+1} into the
+                                         !! next step (set by the scheme's `start`)
+    logical :: reeval = .false.          !! the particles were put back (restart, replay): the
+                                         !! next evaluation repeats the one that made the
+                                         !! carried basis, from the multipliers it started from
   contains
     procedure(step_iface), deferred :: step
     procedure :: name => integrator_name
@@ -54,6 +64,7 @@ module empm_integrator
     procedure :: prepare => integrator_prepare
     procedure :: start => integrator_start
     procedure :: assemble_forces
+    procedure :: resync => integrator_resync
   end type empm_integrator_t
 
   abstract interface
@@ -193,17 +204,24 @@ contains
     call self%assemble_forces(model, model%t)
     call nodal_divide_by_mass(model%nodes, model%nodes%force, model%nodes%acc)
     call g2p_value(model%basis, model%nodes%acc, model%pts%a)
+    self%basis_ready = self%carry
   end subroutine initial_acceleration
 
   !> Evaluate shape functions at the current particle positions (one batched call). With
   !> `timer`, Newton iterations of LME bases are counted in it.
-  subroutine eval_basis(model, stat, timer, ws)
+  subroutine eval_basis(model, stat, timer, ws, again)
     type(empm_model_t), intent(inout) :: model               !! simulation state
     type(empm_step_status_t), intent(inout) :: stat          !! set on failure
     type(empm_phase_timer_t), intent(inout), optional :: timer !! iteration counters
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace: its
                                                              !! node ranges follow the new basis
+    logical, intent(in), optional :: again                   !! repeat the last evaluation:
+                                                             !! the shape state is first put
+                                                             !! back to what it started from
     integer :: ibad, info, iters
+    if (present(again)) then
+      if (again) call model%pts%rewind_shape_state()
+    end if
     if (present(timer)) then
       call model%shape%eval_batch_iters(model%grid, model%pts, model%basis, ibad, info, iters)
       timer%newton_iters = timer%newton_iters + iters
@@ -218,6 +236,51 @@ contains
     end if
   end subroutine eval_basis
 
+  !> End of a step for schemes that need the basis of x^{n+1} (a^{n+1} on the grid the
+  !> particles now see): the shape functions at the new positions and the nodal masses, timed
+  !> as the shape and P2G phases. The next step reuses the basis ([[map_velocity]]), so a
+  !> scheme still evaluates it once per step. On a shape failure `stat` says which particle.
+  subroutine carry_basis(self, model, stat)
+    class(empm_integrator_t), intent(inout) :: self   !! integrator (timer, P2G workspace)
+    type(empm_model_t), intent(inout) :: model        !! simulation state
+    type(empm_step_status_t), intent(inout) :: stat   !! set on failure
+    call eval_basis(model, stat, self%timer, self%p2g)
+    call self%timer%lap(PHASE_SHAPE)
+    if (stat%code /= 0) return
+    ! nodes%vel keeps the step's velocities (local damping reads them).
+    call model%nodes%reset()
+    call p2g_mass(model%basis, model%pts%m, model%nodes%mass, self%p2g)
+    self%basis_ready = .true.
+  end subroutine carry_basis
+
+  !> The particle state was replaced from outside the step (a restart or a guard's replay put
+  !> back a saved state): a basis carried from the last step is stale. A scheme that carries
+  !> its basis re-evaluates it at the next step from the shape state saved with the particles
+  !> (bitwise the evaluation that made it); the others evaluate as usual.
+  subroutine integrator_resync(self, model)
+    class(empm_integrator_t), intent(inout) :: self !! integrator
+    type(empm_model_t), intent(inout) :: model      !! simulation state (unused)
+    associate (unused_model => model); end associate
+    self%reeval = self%carry
+    self%basis_ready = .false.
+  end subroutine integrator_resync
+
+  !> y_p += c a_p for particles 1..np (ndim rows).
+  subroutine particle_axpy(np, c, a, y)
+    integer, intent(in) :: np                      !! number of particles
+    real(wp), intent(in) :: c                      !! scale
+    real(wp), intent(in), contiguous :: a(:,:)     !! particle vectors (ndim, >= np)
+    real(wp), intent(inout), contiguous :: y(:,:)  !! particle vectors (ndim, >= np)
+    integer :: p
+    if (c == 0.0_wp) return
+    !$omp parallel do default(none) shared(np, c, a, y) schedule(static) &
+    !$omp   if(np >= EMPM_OMP_MIN_PARTICLES)
+    do p = 1, np
+      y(:, p) = y(:, p) + c * a(:, p)
+    end do
+    !$omp end parallel do
+  end subroutine particle_axpy
+
   !> The opening of every scheme's step, timed as its shape, P2G and grid phases: shape
   !> functions at the particles; mass and mass-weighted velocity v_p + c w_p on the grid in one
   !> pass (without `c` and `w`: the momentum); nodal velocity = that / mass with the Dirichlet
@@ -231,9 +294,14 @@ contains
     real(wp), intent(in), contiguous, optional :: w(:,:) !! second particle vectors (ndim, np)
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
       call tm%mark()
-      call eval_basis(model, stat, tm, self%p2g)
-      call tm%lap(PHASE_SHAPE)
-      if (stat%code /= 0) return
+      if (self%basis_ready) then
+        self%basis_ready = .false.
+      else
+        call eval_basis(model, stat, tm, self%p2g, self%reeval)
+        self%reeval = .false.
+        call tm%lap(PHASE_SHAPE)
+        if (stat%code /= 0) return
+      end if
       call nodes%reset()
       if (present(c) .and. present(w)) then
         call p2g_mass_momentum(basis, pts%m, pts%v, c, w, nodes%mass, nodes%mom, self%p2g)

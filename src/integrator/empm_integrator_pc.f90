@@ -6,20 +6,21 @@
 !> 1. m_I = Σ N_Ip m_p
 !> 2. predictor v*_I = Σ N_Ip m_p (v_p + (1−γ)Δt a_p) / m_I;  3. Dirichlet values on v*_I
 !> 4. L_p = Σ v*_I ⊗ ∇N_Ip, Δε = Δt sym L;  5. density and stress update
-!> 6. f_I at t+Δt from the new stresses, zero on fixed dofs;  a_I = f_I/m_I
-!> 7. corrector v_I = v*_I + γ Δt a_I
-!> 8. pc_published: a_p = Σ N a_I, v_p += Δt a_p, x_p += Δt Σ N v_I + ½Δt² Σ N a_I
-!>    pc_newmark:   a⁺ = Σ N a_I, v_p += Δt((1−γ) a_p + γ a⁺),
-!>                  x_p += Δt Σ N v*_I + (γ − ½)Δt² a_p, a_p = a⁺
+!> 6. pc_published: f_I at t+Δt from the new stresses (basis of x^n), zero on fixed dofs;
+!>    a_I = f_I/m_I; corrector v_I = v*_I + γ Δt a_I;
+!>    a_p = Σ N a_I, v_p += Δt a_p, x_p += Δt Σ N v_I + ½Δt² Σ N a_I
+!> 7. pc_newmark, drift: x_p += Δt Σ N v*_I + (γ − ½)Δt² a_p, v_p += (1−γ)Δt a_p; then the
+!>    basis at x^{n+1} (kept for the next step), m_I and f_I at t+Δt on it, a_I = f_I/m_I;
+!>    kick: a_p = Σ N a_I, v_p += γΔt a_p
 module empm_integrator_pc
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t
   use empm_params, only: empm_param_t, empm_param, PARAM_REAL
   use empm_namelist, only: empm_group_t
-  use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration
+  use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration, &
+                             carry_basis, particle_axpy
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
-  use empm_transfer, only: g2p_add_scaled, g2p_value, g2p_pc_newmark, &
-                           nodal_divide_by_mass
+  use empm_transfer, only: g2p_add_scaled, g2p_value, nodal_divide_by_mass
   use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
@@ -88,6 +89,7 @@ contains
   subroutine pc_start(self, model)
     class(empm_pc_t), intent(inout) :: self     !! integrator
     type(empm_model_t), intent(inout) :: model  !! simulation state
+    self%carry = self%variant == PC_NEWMARK
     call initial_acceleration(self, model)
   end subroutine pc_start
 
@@ -107,13 +109,13 @@ contains
       call update_stress(model, nodes%vel, dt, stat, self)
       call tm%lap(PHASE_STRESS)
       if (stat%code /= STEP_OK) return
-      ! Balance of forces at t + Δt; nodes%acc = f/m (zero on fixed dofs).
-      call self%assemble_forces(model, model%t + dt)
-      call tm%lap(PHASE_P2G)
-      call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
-      call tm%lap(PHASE_GRID)
-
       if (self%variant == PC_PUBLISHED) then
+        ! Balance of forces at t + Δt with the basis of x^n, as published; nodes%acc = f/m
+        ! (zero on fixed dofs).
+        call self%assemble_forces(model, model%t + dt)
+        call tm%lap(PHASE_P2G)
+        call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
+        call tm%lap(PHASE_GRID)
         ! Corrector v_I = v* + γΔt a_I into the scratch array; eqs. (33)–(35).
         nodes%work = nodes%vel + g * dt * nodes%acc
         call g2p_add_scaled(basis, dt, nodes%work, pts%x)
@@ -121,9 +123,21 @@ contains
         call g2p_value(basis, nodes%acc, pts%a)
         pts%v(:, 1:pts%np) = pts%v(:, 1:pts%np) + dt * pts%a(:, 1:pts%np)
       else
-        ! Newmark β = 0: x uses v* (the displacement step 4 strained with) and a_p^n; one
-        ! pass over the particles.
-        call g2p_pc_newmark(basis, dt, g, nodes%vel, nodes%acc, pts%x, pts%v, pts%a)
+        ! Newmark β = 0, drift: x uses v* (the displacement step 4 strained with) and a_p^n.
+        call g2p_add_scaled(basis, dt, nodes%vel, pts%x)
+        call particle_axpy(pts%np, (g - 0.5_wp) * dt * dt, pts%a, pts%x)
+        call particle_axpy(pts%np, (1.0_wp - g) * dt, pts%a, pts%v)
+        call tm%lap(PHASE_G2P)
+        ! Kick with the basis of x^{n+1}: a^{n+1} = f(σ^{n+1}, t + Δt)/m on the grid the
+        ! particles now see (the basis then serves the next step too: one evaluation per step).
+        call carry_basis(self, model, stat)
+        if (stat%code /= STEP_OK) return
+        call self%assemble_forces(model, model%t + dt)
+        call tm%lap(PHASE_P2G)
+        call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
+        call tm%lap(PHASE_GRID)
+        call g2p_value(basis, nodes%acc, pts%a)
+        call particle_axpy(pts%np, g * dt, pts%a, pts%v)
       end if
       call tm%lap(PHASE_G2P)
     end associate

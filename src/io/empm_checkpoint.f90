@@ -102,6 +102,8 @@ contains
       call h5_write(g, 'lp', p%lp(:, 1:n), ierr)
       call h5_write(g, 'lam', p%lam(:, 1:n), ierr)
       call h5_write(g, 'lam_old', p%lam_old(:, 1:n), ierr)
+      call h5_write(g, 'lam_prev', p%lam_prev(:, 1:n), ierr)
+      call h5_write(g, 'lam_old_prev', p%lam_old_prev(:, 1:n), ierr)
       call h5_write(g, 'mat', real(p%mat(1:n), wp), ierr)
       if (p%nstate > 0) call h5_write(g, 'state', p%state(:, 1:n), ierr)
     end associate
@@ -281,6 +283,8 @@ contains
       call h5_read(g, 'lp', p%lp(:, 1:n), ierr)
       call h5_read(g, 'lam', p%lam(:, 1:n), ierr)
       call h5_read(g, 'lam_old', p%lam_old(:, 1:n), ierr)
+      call h5_read(g, 'lam_prev', p%lam_prev(:, 1:n), ierr)
+      call h5_read(g, 'lam_old_prev', p%lam_old_prev(:, 1:n), ierr)
       deallocate(r1); allocate(r1(n)); call h5_read(g, 'mat', r1, ierr)
       p%mat(1:n) = nint(r1)
       if (p%nstate > 0) call h5_read(g, 'state', p%state(:, 1:n), ierr)

@@ -34,6 +34,9 @@ module empm_particles
     real(wp), allocatable :: lam(:,:)       !! shape-function state (LME Lagrange multiplier) (ndim, np)
     real(wp), allocatable :: lam_old(:,:)   !! its value one evaluation earlier (LME extrapolation;
                                             !! huge = no history yet)
+    real(wp), allocatable :: lam_prev(:,:)  !! `lam` before the last evaluation (ndim, np): with
+    real(wp), allocatable :: lam_old_prev(:,:) !! this, what that evaluation started from
+                                            !! ([[particles_rewind_shape_state]])
     integer, allocatable :: mat(:)          !! material index (np)
     integer :: nstate = 0                   !! state variables per particle (rows of `state`)
     real(wp), allocatable :: state(:,:)     !! materials' state variables (nstate, np)
@@ -42,6 +45,7 @@ module empm_particles
     procedure :: set_nstate => particles_set_nstate
     procedure :: append => particles_append
     procedure :: copy_state_from => particles_copy_state
+    procedure :: rewind_shape_state => particles_rewind_shape_state
   end type empm_particles_t
 
 contains
@@ -70,11 +74,12 @@ contains
     allocate(self%x(ndim, n), self%x0(ndim, n), self%v(ndim, n), self%a(ndim, n), &
       self%m(n), self%vol(n), self%vol0(n), self%rho(n), self%stress(6, n), self%strain(6, n), &
       self%F(3, 3, n), self%lp(ndim, n), self%lam(ndim, n), &
-      self%lam_old(ndim, n), self%mat(n), self%state(ns, n), stat=st, errmsg=msg)
+      self%lam_old(ndim, n), self%lam_prev(ndim, n), self%lam_old_prev(ndim, n), self%mat(n), &
+      self%state(ns, n), stat=st, errmsg=msg)
     if (st /= 0) then
       call release(self)
-      ! 7 vectors, 4 scalars, 2 Voigt tensors, F and the state in reals; the material index.
-      bytes = int(n, int64) * (8_int64 * (7 * ndim + 4 + 12 + 9 + int(ns, int64)) + 4_int64)
+      ! 9 vectors, 4 scalars, 2 Voigt tensors, F and the state in reals; the material index.
+      bytes = int(n, int64) * (8_int64 * (9 * ndim + 4 + 12 + 9 + int(ns, int64)) + 4_int64)
       call empm_raise_error(empm_alloc_error('particle storage ('//str(n)//' particles)', &
         bytes, trim(msg)), err)
     end if
@@ -120,6 +125,8 @@ contains
     if (allocated(self%lp)) deallocate(self%lp)
     if (allocated(self%lam)) deallocate(self%lam)
     if (allocated(self%lam_old)) deallocate(self%lam_old)
+    if (allocated(self%lam_prev)) deallocate(self%lam_prev)
+    if (allocated(self%lam_old_prev)) deallocate(self%lam_old_prev)
     if (allocated(self%mat)) deallocate(self%mat)
     if (allocated(self%state)) deallocate(self%state)
   end subroutine release
@@ -164,6 +171,7 @@ contains
     self%F(3, 3, n) = 1.0_wp
     ! lam_old = huge: no history yet (see the LME warm-start extrapolation).
     self%lp(:, n) = lp(1:d); self%lam(:, n) = 0.0_wp; self%lam_old(:, n) = huge(1.0_wp)
+    self%lam_prev(:, n) = 0.0_wp; self%lam_old_prev(:, n) = huge(1.0_wp)
     self%mat(n) = mat
     self%state(:, n) = 0.0_wp
   end subroutine particles_append
@@ -188,8 +196,20 @@ contains
     self%F(:, :, 1:n) = src%F(:, :, 1:n)
     self%lp(:, 1:n) = src%lp(:, 1:n); self%lam(:, 1:n) = src%lam(:, 1:n)
     self%lam_old(:, 1:n) = src%lam_old(:, 1:n)
+    self%lam_prev(:, 1:n) = src%lam_prev(:, 1:n)
+    self%lam_old_prev(:, 1:n) = src%lam_old_prev(:, 1:n)
     self%mat(1:n) = src%mat(1:n)
   end subroutine particles_copy_state
+
+  !> Put the shape state (the LME multipliers) back to what the last basis evaluation started
+  !> from, so that evaluating again at the same positions repeats it bit for bit.
+  subroutine particles_rewind_shape_state(self)
+    class(empm_particles_t), intent(inout) :: self !! particles
+    integer :: n
+    n = self%np
+    self%lam(:, 1:n) = self%lam_prev(:, 1:n)
+    self%lam_old(:, 1:n) = self%lam_old_prev(:, 1:n)
+  end subroutine particles_rewind_shape_state
 
   subroutine move_alloc_all(from, to)
     type(empm_particles_t), intent(inout) :: from
@@ -203,6 +223,8 @@ contains
     call move_alloc(from%F, to%F)
     call move_alloc(from%lp, to%lp); call move_alloc(from%lam, to%lam)
     call move_alloc(from%lam_old, to%lam_old)
+    call move_alloc(from%lam_prev, to%lam_prev)
+    call move_alloc(from%lam_old_prev, to%lam_old_prev)
     call move_alloc(from%mat, to%mat)
     to%nstate = from%nstate
     call move_alloc(from%state, to%state)

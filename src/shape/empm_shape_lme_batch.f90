@@ -72,6 +72,8 @@ contains
       ! λ* changes smoothly, so 2λ_n − λ_(n−1) is off by O(Δx²) and one Newton step usually
       ! reaches the tolerance (the plain warm start λ_n needs two). lam_old = huge marks a
       ! particle without a converged history yet (set at generation): plain warm start.
+      ! What this evaluation starts from, kept so that it can be repeated exactly.
+      pts%lam_prev(:, p) = pts%lam(:, p); pts%lam_old_prev(:, p) = pts%lam_old(:, p)
       if (pts%lam_old(1, p) == huge(1.0_wp)) then
         lam(1:nd) = pts%lam(:, p)
       else

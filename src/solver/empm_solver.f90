@@ -233,6 +233,7 @@ contains
     if (allocated(cfg%snapshot_times)) nsnap = size(cfg%snapshot_times)
     if (present(resume)) then
       call model%pts%copy_state_from(good)
+      call integ%resync(model)
       call restore_tractions()
       model%residual = residual0
       isnap = resume%isnap
@@ -431,6 +432,7 @@ contains
       type(empm_step_status_t) :: rs
       integer :: i
       call model%pts%copy_state_from(good)
+      call integ%resync(model)
       call restore_tractions()
       model%t = t_good; model%step = step_good
       do i = 1, nrep - 1

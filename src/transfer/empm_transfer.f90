@@ -29,14 +29,14 @@ module empm_transfer
   use empm_nodes, only: empm_nodes_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_transfer_2d, only: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, &
-                              g2p_2d, g2p_pc_newmark_2d
+                              g2p_2d
   use empm_transfer_q4, only: mass_q4, weighted_q4, mass_momentum_q4, body_force_q4, &
-                              internal_force_q4, velocity_gradient_q4, g2p_q4, g2p_pc_newmark_q4
+                              internal_force_q4, velocity_gradient_q4, g2p_q4
   implicit none
   private
   public :: empm_p2g_work_t
   public :: p2g_mass, p2g_weighted, p2g_mass_momentum, p2g_internal_force, p2g_body_force
-  public :: g2p_value, g2p_add_scaled, g2p_pc_newmark, velocity_gradient
+  public :: g2p_value, g2p_add_scaled, velocity_gradient
   public :: nodal_divide_by_mass
 
   !> Workspace of a race-free threaded P2G: the mode, the node ranges and the per-thread
@@ -550,54 +550,6 @@ contains
     !$omp end parallel do
   end subroutine g2p_add_scaled
 
-  !> The Newmark-consistent particle update of the predictor-corrector in one pass over the
-  !> particles (the same arithmetic as the separate G2P calls, in the same order):
-  !> x += Δt Σ N v*_I + (γ − ½)Δt² a;  v += (1−γ)Δt a;  a = Σ N a_I;  v += γΔt a.
-  subroutine g2p_pc_newmark(basis, dt, g, vel, acc, x, v, a)
-    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
-    real(wp), intent(in) :: dt                       !! time step [s]
-    real(wp), intent(in) :: g                        !! Newmark γ
-    real(wp), intent(in), contiguous :: vel(:,:)     !! predicted nodal velocities v*_I (ndim, nnode)
-    real(wp), intent(in), contiguous :: acc(:,:)     !! nodal accelerations a_I (ndim, nnode)
-    real(wp), intent(inout), contiguous :: x(:,:)    !! particle positions (ndim, np)
-    real(wp), intent(inout), contiguous :: v(:,:)    !! particle velocities (ndim, np)
-    real(wp), intent(inout), contiguous :: a(:,:)    !! particle accelerations (ndim, np): a^n in,
-                                                     !! a^{n+1} out
-    real(wp) :: sv(3), sa(3)
-    integer :: c, nc, p0, p1, p, k, I, d
-    d = basis%ndim
-    nc = empm_chunks(basis%np)
-    !$omp parallel do num_threads(nc) schedule(static, 1) default(none) &
-    !$omp   shared(basis, dt, g, vel, acc, x, v, a, nc, d) &
-    !$omp   private(p0, p1, p, k, I, sv, sa) if(nc > 1)
-    do c = 0, nc - 1
-      call empm_chunk_bounds(basis%np, nc, c, p0, p1)
-      if (basis%layout == BASIS_Q4) then
-        call g2p_pc_newmark_q4(basis%stride, p0, p1, basis%cell, basis%t, dt, g, vel, acc, &
-                               x, v, a)
-        cycle
-      end if
-      if (d == 2) then
-        call g2p_pc_newmark_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, dt, g, &
-                               vel, acc, x, v, a)
-        cycle
-      end if
-      do p = p0, p1
-        sv(1:d) = 0.0_wp; sa(1:d) = 0.0_wp
-        do k = 1, basis%nn(p)
-          I = basis%node(k, p)
-          sv(1:d) = sv(1:d) + basis%N(k, p) * vel(:, I)
-          sa(1:d) = sa(1:d) + basis%N(k, p) * acc(:, I)
-        end do
-        x(:, p) = x(:, p) + dt * sv(1:d)
-        x(:, p) = x(:, p) + (g - 0.5_wp) * dt * dt * a(:, p)
-        v(:, p) = v(:, p) + (1.0_wp - g) * dt * a(:, p)
-        a(:, p) = sa(1:d)
-        v(:, p) = v(:, p) + g * dt * a(:, p)
-      end do
-    end do
-    !$omp end parallel do
-  end subroutine g2p_pc_newmark
 
   !> Velocity gradients L_p = Σ_I v_I ⊗ ∇N_Ip of particles p0..p1, into L(:, :, 1:p1-p0+1).
   !> Serial, for one block of particles inside a particle-parallel loop (the stress update

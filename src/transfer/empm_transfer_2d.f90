@@ -13,8 +13,7 @@ module empm_transfer_2d
   use empm_kinds, only: wp
   implicit none
   private
-  public :: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, g2p_2d, &
-            g2p_pc_newmark_2d
+  public :: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, g2p_2d
 
 contains
 
@@ -123,35 +122,4 @@ contains
     end do
   end subroutine g2p_2d
 
-  !> The Newmark-consistent predictor-corrector particle update (see [[g2p_pc_newmark]]).
-  pure subroutine g2p_pc_newmark_2d(mx, p0, p1, nn, node, N, dt, g, vel, acc, x, v, a)
-    integer, intent(in) :: mx                !! basis capacity
-    integer, intent(in) :: p0                !! first particle
-    integer, intent(in) :: p1                !! last particle
-    integer, intent(in) :: nn(*)             !! nodes per particle
-    integer, intent(in) :: node(mx, *)       !! node indices
-    real(wp), intent(in) :: N(mx, *)         !! shape-function values
-    real(wp), intent(in) :: dt               !! time step [s]
-    real(wp), intent(in) :: g                !! Newmark γ
-    real(wp), intent(in) :: vel(2, *)        !! predicted nodal velocities v*_I
-    real(wp), intent(in) :: acc(2, *)        !! nodal accelerations a_I
-    real(wp), intent(inout) :: x(2, *)       !! particle positions
-    real(wp), intent(inout) :: v(2, *)       !! particle velocities
-    real(wp), intent(inout) :: a(2, *)       !! particle accelerations: a^n in, a^{n+1} out
-    real(wp) :: sv(2), sa(2), cx, cv0, cv1, nk
-    integer :: p, k, I
-    ! The generic kernel's coefficients, formed in its evaluation order.
-    cx = (g - 0.5_wp) * dt * dt; cv0 = (1.0_wp - g) * dt; cv1 = g * dt
-    do p = p0, p1
-      sv = 0.0_wp; sa = 0.0_wp
-      do k = 1, nn(p)
-        I = node(k, p); nk = N(k, p)
-        sv = sv + nk * vel(:, I)
-        sa = sa + nk * acc(:, I)
-      end do
-      x(:, p) = x(:, p) + dt * sv + cx * a(:, p)
-      v(:, p) = v(:, p) + cv0 * a(:, p) + cv1 * sa
-      a(:, p) = sa
-    end do
-  end subroutine g2p_pc_newmark_2d
 end module empm_transfer_2d

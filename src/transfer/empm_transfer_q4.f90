@@ -17,7 +17,7 @@ module empm_transfer_q4
   implicit none
   private
   public :: mass_q4, weighted_q4, mass_momentum_q4, body_force_q4, internal_force_q4, &
-            velocity_gradient_q4, g2p_q4, g2p_pc_newmark_q4
+            velocity_gradient_q4, g2p_q4
 
 contains
 
@@ -217,36 +217,4 @@ contains
     end do
   end subroutine g2p_q4
 
-  !> The Newmark-consistent predictor-corrector particle update (see [[g2p_pc_newmark]]).
-  pure subroutine g2p_pc_newmark_q4(s, p0, p1, cell, t, dt, g, vel, acc, x, v, a)
-    integer, intent(in) :: s                 !! nodes along x
-    integer, intent(in) :: p0                !! first particle
-    integer, intent(in) :: p1                !! last particle
-    integer, intent(in) :: cell(*)           !! lowest node of each particle's cell
-    real(wp), intent(in) :: t(2, *)          !! local coordinates
-    real(wp), intent(in) :: dt               !! time step [s]
-    real(wp), intent(in) :: g                !! Newmark γ
-    real(wp), intent(in) :: vel(2, *)        !! predicted nodal velocities v*_I
-    real(wp), intent(in) :: acc(2, *)        !! nodal accelerations a_I
-    real(wp), intent(inout) :: x(2, *)       !! particle positions
-    real(wp), intent(inout) :: v(2, *)       !! particle velocities
-    real(wp), intent(inout) :: a(2, *)       !! particle accelerations: a^n in, a^{n+1} out
-    real(wp) :: N(4), sv(2), sa(2), cx, cv0, cv1
-    integer :: p
-    integer(int64) :: I, J ! 64-bit: the neighbours' addresses are offsets of I's
-    ! The generic kernel's coefficients, formed in its evaluation order.
-    cx = (g - 0.5_wp) * dt * dt; cv0 = (1.0_wp - g) * dt; cv1 = g * dt
-    do p = p0, p1
-      call q4_values(t(1, p), t(2, p), N)
-      I = cell(p); J = I + s
-      sv = 0.0_wp; sa = 0.0_wp
-      sv = sv + N(1) * vel(:, I);     sa = sa + N(1) * acc(:, I)
-      sv = sv + N(2) * vel(:, I + 1); sa = sa + N(2) * acc(:, I + 1)
-      sv = sv + N(3) * vel(:, J);     sa = sa + N(3) * acc(:, J)
-      sv = sv + N(4) * vel(:, J + 1); sa = sa + N(4) * acc(:, J + 1)
-      x(:, p) = x(:, p) + dt * sv + cx * a(:, p)
-      v(:, p) = v(:, p) + cv0 * a(:, p) + cv1 * sa
-      a(:, p) = sa
-    end do
-  end subroutine g2p_pc_newmark_q4
 end module empm_transfer_q4

@@ -26,6 +26,8 @@ module empm_verify_spec
     real(wp) :: thresholds(MAXLIST) = 0.0_wp     !! matrix study: upper bounds
     real(wp) :: min_order = 0.0_wp               !! convergence study: required order
     real(wp) :: max_order = huge(1.0_wp)         !! convergence study: order must stay below
+    real(wp) :: max_error = huge(1.0_wp)         !! convergence study: bound on the error of
+                                                 !! the finest level (unset: not asserted)
                                                  !! (to assert a known loss of convergence)
     character(len=64) :: expect_fail(MAXLIST) = '' !! run-id patterns expected to fail a check
     character(len=32) :: label = ''              !! variant of the study, part of its ids
@@ -48,7 +50,7 @@ contains
     type(empm_verify_spec_t), intent(out) :: spec            !! the study
     character(len=:), allocatable, intent(out) :: emsg       !! '' or the problem
     character(len=*), parameter :: K = 'benchmark, study, shapes, schemes, levels, cfls, '// &
-      'metrics, thresholds, min_order, max_order, expect_fail, expect_abort, expect_excess, '// &
+      'metrics, thresholds, min_order, max_order, max_error, expect_fail, expect_abort, expect_excess, '// &
       'expect_order_below, label, quick_levels, quick'
     character(len=32) :: benchmark, metrics(MAXLIST)
     character(len=64) :: expect_fail(MAXLIST)
@@ -56,16 +58,17 @@ contains
     character(len=32) :: label
     integer :: levels(MAXLIST), quick_levels, u, ios
     real(wp) :: cfls(MAXLIST), thresholds(MAXLIST), min_order, max_order, expect_excess, &
-                expect_order_below
+                expect_order_below, max_error
     logical :: quick, expect_abort, expects
     character(len=512) :: msg
     namelist /verify/ benchmark, study, shapes, schemes, levels, cfls, metrics, thresholds, &
-      min_order, max_order, expect_fail, expect_abort, expect_excess, expect_order_below, label, &
+      min_order, max_order, max_error, expect_fail, expect_abort, expect_excess, expect_order_below, label, &
       quick_levels, quick
     emsg = ''
     spec%file = path
     benchmark = ''; study = 'matrix'; shapes = ''; schemes = ''; levels = 0; cfls = 0.0_wp
     metrics = ''; thresholds = -huge(1.0_wp); min_order = -huge(1.0_wp); max_order = huge(1.0_wp)
+    max_error = huge(1.0_wp)
     quick_levels = 2; quick = .true.; expect_fail = ''; label = ''; expect_abort = .false.
     expect_excess = 0.0_wp; expect_order_below = -huge(1.0_wp)
     open(newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
@@ -83,7 +86,7 @@ contains
     spec%nshape = count(shapes /= ''); spec%shapes = shapes
     spec%nscheme = count(schemes /= ''); spec%schemes = schemes
     spec%quick_levels = quick_levels; spec%quick = quick; spec%min_order = min_order
-    spec%max_order = max_order; spec%expect_fail = expect_fail; spec%label = lower(label)
+    spec%max_order = max_order; spec%max_error = max_error; spec%expect_fail = expect_fail; spec%label = lower(label)
     spec%expect_abort = expect_abort; spec%expect_excess = expect_excess
     spec%expect_order_below = expect_order_below
     expects = any(len_trim(expect_fail) > 0)

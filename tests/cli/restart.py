@@ -183,9 +183,13 @@ def geotech(empm, work):
 
 
 def long_case(work, every=100):
+    # A long run must stay physical: at v0 = 0.5 the particles cross cells and linear MPM's
+    # energy grows (+78 % over 600 s, until a particle leaves the grid); at 0.05 it is conserved
+    # to 1e-4.
     case = os.path.join(work, "long.nml")
     with open(case, "w") as f:
         f.write(CASE_1D.format(shape="linear", scheme="pc_newmark")
+                .replace("velocity_sine_amplitude = 0.5", "velocity_sine_amplitude = 0.05")
                 .replace("t_end = 3.0", "t_end = 600.0")
                 .replace("checkpoint_every = 40", f"checkpoint_every = {every}")
                 .replace("snapshot_times = 1.0, 2.0", "snapshot_times = 150.0, 300.0"))
