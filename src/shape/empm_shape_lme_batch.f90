@@ -68,12 +68,12 @@ contains
     !$omp   shared(self, grid, pts, basis, fast, nd, hs, cut, rmax, ibad, info) &
     !$omp   private(pinfo, it, lam, k) reduction(+: iters) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
+      ! What this evaluation starts from, kept so that it can be repeated exactly.
+      pts%lam_prev(:, p) = pts%lam(:, p); pts%lam_old_prev(:, p) = pts%lam_old(:, p)
       ! Warm start extrapolated from the last two converged multipliers: in a smooth motion
       ! λ* changes smoothly, so 2λ_n − λ_(n−1) is off by O(Δx²) and one Newton step usually
       ! reaches the tolerance (the plain warm start λ_n needs two). lam_old = huge marks a
       ! particle without a converged history yet (set at generation): plain warm start.
-      ! What this evaluation starts from, kept so that it can be repeated exactly.
-      pts%lam_prev(:, p) = pts%lam(:, p); pts%lam_old_prev(:, p) = pts%lam_old(:, p)
       if (pts%lam_old(1, p) == huge(1.0_wp)) then
         lam(1:nd) = pts%lam(:, p)
       else
