@@ -130,6 +130,11 @@ program empm_main
         read(numtext, *, iostat=ios) bcfg%confinement
         if (ios /= 0 .or. bcfg%confinement < 0) &
           call die('--confinement needs a pressure >= 0 [Pa]')
+      case ('--min-fill')
+        numtext = arg(i + 1)
+        read(numtext, *, iostat=ios) bcfg%min_fill
+        if (ios /= 0 .or. bcfg%min_fill < 0 .or. bcfg%min_fill > 0.5) &
+          call die('--min-fill needs a fill fraction in [0, 0.5] (&grid min_fill)')
       case default;          call die('unknown option '//arg(i))
       end select
       i = i + 2
@@ -227,7 +232,7 @@ contains
     write(u, '(a)') 'usage: empm bench [--dim 2|3] [--shape S] [--cells N] [--ppc P] [--steps K]'
     write(u, '(a)') '                  [--threads T] [--integrator I] [--warmup W]'
     write(u, '(a)') '                  [--material M] [--material-keys ''k = v, ...'']'
-    write(u, '(a)') '                  [--confinement P0]'
+    write(u, '(a)') '                  [--confinement P0] [--min-fill F]'
     write(u, '(a)') ''
     write(u, '(a)') 'Times a freely vibrating block (N^dim cells, P particles per cell) and'
     write(u, '(a)') 'prints one JSON object (docs/performance.md). S is a shape identifier as in a'
@@ -241,7 +246,8 @@ contains
     write(u, '(a)') 'the same name and adds others. The block starts under an isotropic pressure'
     write(u, '(a)') 'P0 [Pa] (default: 1e4 for camclay, 0 otherwise), between smooth rigid walls'
     write(u, '(a)') 'when P0 > 0 (so that it stays confined). A umat library path is'
-    write(u, '(a)') 'relative to the working folder. "plastic_fraction" in the output is the'
+    write(u, '(a)') 'relative to the working folder. F is the fill below which nodes are extended'
+    write(u, '(a)') '(&grid min_fill; default 0.1, 0: off). "plastic_fraction" in the output is the'
     write(u, '(a)') 'share of particle updates that changed a state variable.'
   end subroutine usage_bench
 

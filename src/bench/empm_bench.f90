@@ -59,6 +59,7 @@ module empm_bench
     character(len=512) :: material_keys = ''         !! 'key = value, ...' replacing defaults
     real(wp) :: confinement = -1.0_wp                !! initial isotropic compression p0 [Pa]
                                                      !! (< 0: the model's bench default)
+    real(wp) :: min_fill = -1.0_wp                   !! `&grid min_fill` (< 0: the default)
   end type empm_bench_config_t
 
   !> What was measured (the JSON of `empm bench`, plus a checksum for tests).
@@ -182,6 +183,7 @@ contains
       end do
     end if
     call model%finalize_setup()
+    if (cfg%min_fill >= 0.0_wp) model%nodes%ext%theta = cfg%min_fill
     call integ%prepare(model)
     dt = 0.5_wp * empm_stable_dt(model)
 

@@ -5,6 +5,7 @@ module empm_nodes
   use empm_error, only: empm_error_t, empm_raise_error, empm_alloc_error
   use empm_strings, only: str
   use empm_grid, only: empm_grid_t
+  use empm_extension, only: empm_extension_t
   implicit none
   private
   public :: empm_nodes_t
@@ -20,6 +21,9 @@ module empm_nodes
     real(wp), allocatable :: force(:,:)     !! total force f_I (ndim, nnode) [N]
     real(wp), allocatable :: acc(:,:)       !! acceleration a_I = f_I/m_I (ndim, nnode) [m/s²]
     real(wp), allocatable :: work(:,:)      !! scratch nodal vector (ndim, nnode)
+    real(wp), allocatable :: vol(:)         !! filled volume Σ N_Ip V_p (nnode) [m^ndim], for
+                                            !! the extension of nearly-empty nodes
+    type(empm_extension_t) :: ext           !! nearly-empty nodes of the current basis
     ! The constraints are private: `fixed_dofs` must follow `fixed`, so they change only
     ! through fix_box/fix_dof, and are read through is_fixed/fixed_velocity/nfixed.
     logical, allocatable, private :: fixed(:,:)     !! Dirichlet mask per dof (ndim, nnode)
@@ -49,6 +53,7 @@ module empm_nodes
     procedure :: constrain_force => nodes_constrain_force
     procedure :: compute_reactions => nodes_compute_reactions
     procedure :: local_damping => nodes_local_damping
+    procedure :: find_degenerate => nodes_find_degenerate
     procedure, private :: list_fixed => nodes_list_fixed
   end type empm_nodes_t
 
@@ -65,9 +70,9 @@ contains
     d = grid%ndim; n = grid%nnode
     self%ndim = d; self%nnode = n
     if (allocated(self%mass)) deallocate(self%mass, self%mom, self%vel, self%force, self%acc, &
-      self%work, self%fixed, self%vfix)
+      self%work, self%fixed, self%vfix, self%vol)
     allocate(self%mass(n), self%mom(d, n), self%vel(d, n), self%force(d, n), self%acc(d, n), &
-      self%work(d, n), self%fixed(d, n), self%vfix(d, n), stat=stat, errmsg=msg)
+      self%work(d, n), self%fixed(d, n), self%vfix(d, n), self%vol(n), stat=stat, errmsg=msg)
     if (stat /= 0) then
       self%nnode = 0
       call empm_raise_error(empm_alloc_error('nodal fields ('//str(n)//' nodes)', &
@@ -84,7 +89,17 @@ contains
     self%set_ptr(1) = 1
     call zero(self%mass, n); call zero(self%mom, d * n); call zero(self%vel, d * n)
     call zero(self%force, d * n); call zero(self%acc, d * n); call zero(self%work, d * n)
+    call zero(self%vol, n)
+    call self%ext%init(n)
   end subroutine nodes_alloc
+
+  !> The nearly-empty nodes of a new basis ([[empm_extension]]), from the nodal masses and the
+  !> filled volumes `vol` just accumulated; a node with a fixed dof is never one.
+  subroutine nodes_find_degenerate(self, grid)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields
+    type(empm_grid_t), intent(in) :: grid      !! background grid
+    call self%ext%find(grid, self%mass, self%vol, self%mass_tol, self%fixed)
+  end subroutine nodes_find_degenerate
 
   !> Zero the fields P2G accumulates into, mass and momentum (step 9 of the paper's
   !> algorithm); constraints are kept. The other nodal fields are outputs, written at every node
@@ -271,6 +286,8 @@ contains
     real(wp), intent(inout), contiguous :: mom(:,:)   !! nodal momenta (ndim, nnode)
     call constrain_dofs(size(self%fixed_dofs), self%fixed_dofs, self%ndim, self%mass, &
                         self%vfix, v, mom)
+    ! Nearly-empty nodes extrapolate from the constrained values.
+    if (self%ext%n > 0) call self%ext%scatter(v)
   end subroutine nodes_constrain_velocity
 
   !> v = vfix and mom = m vfix on the listed dofs (positions in the (ndim, nnode) arrays).

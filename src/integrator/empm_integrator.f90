@@ -178,6 +178,7 @@ contains
     if (stat%code /= 0) return
     call model%nodes%reset()
     call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
+    call extend_masses(self, model, .true.)
     model%nodes%vel = 0.0_wp ! no damping in this assembly
     call self%assemble_forces(model, model%t)
   end subroutine monitor_initial
@@ -201,6 +202,7 @@ contains
     if (stat%code /= 0) return
     call model%nodes%reset()
     call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
+    call extend_masses(self, model, .true.)
     call self%assemble_forces(model, model%t)
     call nodal_divide_by_mass(model%nodes, model%nodes%force, model%nodes%acc)
     call g2p_value(model%basis, model%nodes%acc, model%pts%a)
@@ -250,8 +252,27 @@ contains
     ! nodes%vel keeps the step's velocities (local damping reads them).
     call model%nodes%reset()
     call p2g_mass(model%basis, model%pts%m, model%nodes%mass, self%p2g)
+    call extend_masses(self, model, .true.)
     self%basis_ready = .true.
   end subroutine carry_basis
+
+  !> After the nodal masses were accumulated: with the extension of nearly-empty nodes on
+  !> ([[empm_extension]]), find them when the basis is new (`fresh`; their filled volumes in
+  !> one more P2G) and gather the masses, m̂ = Eᵀm. Without degenerate nodes nothing changes.
+  subroutine extend_masses(self, model, fresh)
+    class(empm_integrator_t), intent(inout) :: self   !! integrator (P2G workspace)
+    type(empm_model_t), intent(inout) :: model        !! simulation state
+    logical, intent(in) :: fresh                      !! the basis was just evaluated
+    associate (nodes => model%nodes)
+      if (nodes%ext%theta <= 0.0_wp) return
+      if (fresh) then
+        nodes%vol = 0.0_wp
+        call p2g_mass(model%basis, model%pts%vol, nodes%vol, self%p2g)
+        call nodes%find_degenerate(model%grid)
+      end if
+      if (nodes%ext%n > 0) call nodes%ext%gather_mass(nodes%mass)
+    end associate
+  end subroutine extend_masses
 
   !> The particle state was replaced from outside the step (a restart or a guard's replay put
   !> back a saved state): a basis carried from the last step is stale. A scheme that carries
@@ -292,8 +313,10 @@ contains
     type(empm_step_status_t), intent(inout) :: stat   !! set on failure
     real(wp), intent(in), optional :: c               !! scale of `w`
     real(wp), intent(in), contiguous, optional :: w(:,:) !! second particle vectors (ndim, np)
+    logical :: fresh
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
       call tm%mark()
+      fresh = .not. self%basis_ready
       if (self%basis_ready) then
         self%basis_ready = .false.
       else
@@ -309,6 +332,7 @@ contains
         call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
                                self%p2g)
       end if
+      call extend_masses(self, model, fresh)
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
       call nodes%constrain_velocity(nodes%vel, nodes%mom)

@@ -18,6 +18,8 @@ module empm_case
     real(wp) :: cfl = -1.0_wp                    !! Courant number (if > 0)
     real(wp) :: dt = -1.0_wp                     !! fixed time step (if > 0)
     real(wp) :: t_end = -1.0_wp                  !! end time (if > 0)
+    integer :: ppc = 0                           !! particles per cell of every generated body
+                                                 !! (if > 0)
   end type empm_overrides_t
 
   !> A runnable case.

@@ -22,6 +22,7 @@ module empm_input
   use empm_case, only: empm_case_t, empm_overrides_t
   use empm_model, only: empm_material_slot_t
   use empm_loads, only: RAMP_NONE, RAMP_SINE, RAMP_LINEAR, empm_traction_t, empm_geostatic_stress
+  use empm_extension, only: EXT_THETA_DEFAULT
   use empm_particle_gen, only: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
   use empm_shape, only: shape_status_text
   use empm_registry, only: empm_registry_t, empm_default_registry
@@ -62,7 +63,12 @@ contains
           'direction', count=3, lo=0.0_wp, lo_open=.true., hi=LMAX), &
         empm_param('cells', PARAM_INT, '-', 'number of cells per direction (ndim values); the '// &
           'grid must fit in memory (checked before allocating)', count=3, lo=1.0_wp, &
-          hi=1.0e8_wp)]
+          hi=1.0e8_wp), &
+        empm_param('min_fill', PARAM_REAL, '-', 'a free node whose support the bodies fill '// &
+          'less than this fraction (sum of N_Ip V_p over h^ndim) is extrapolated from its '// &
+          'well-filled neighbours instead of divided by its tiny mass (docs/free-surfaces.md); '// &
+          '0 turns the extension off', default=str_short(EXT_THETA_DEFAULT), &
+          lo=0.0_wp, hi=0.5_wp)]
     case ('material')
       p = [ &
         empm_param('name', PARAM_STR, '-', 'label referenced by &particles material (unique)'), &
@@ -72,7 +78,8 @@ contains
       p = [ &
         empm_param('material', PARAM_STR, '-', 'a &material name'), &
         empm_param('geometry', PARAM_STR, '-', 'body shape: box (interval in 1D), disk '// &
-          '(sphere in 3D, ndim >= 2) or file (points or mesh read from `file`)', &
+          '(sphere in 3D, ndim >= 2) or file (points or mesh read from `file`); a box face '// &
+          'inside a cell fills only the part of the cell inside the box (docs/free-surfaces.md)', &
           default='''box''', choices='box interval disk sphere file'), &
         empm_param('lo', PARAM_REAL, 'm', 'box: lower corner (required for a box)', count=3, &
           lo=-LMAX, hi=LMAX, optional=.true.), &
@@ -262,7 +269,7 @@ contains
     if (e%code == EMPM_OK) call read_grid(path, gs, cs, ov, e)
     if (e%code == EMPM_OK) call read_materials(path, gs, cs, reg, e)
     if (e%code == EMPM_OK) call read_shape(gs, cs, ov, reg, e)
-    if (e%code == EMPM_OK) call read_particles(path, gs, cs, e)
+    if (e%code == EMPM_OK) call read_particles(path, gs, cs, ov, e)
     if (e%code == EMPM_OK) call read_integrator(path, gs, cs, ov, reg, e)
     if (e%code == EMPM_OK) call read_loads(gs, cs, e)
     if (e%code == EMPM_OK) call apply_geostatic(gs, cs, e)
@@ -364,6 +371,7 @@ contains
     if (e%code /= EMPM_OK) return
     h(max(n, 1) + 1:3) = h(1)  ! one value applies to every direction
     call g%get(p(4), cells, n, e)
+    call g%get(p(5), cs%model%nodes%ext%theta, e)
     if (e%code /= EMPM_OK) return
     if (n < ndim) then
       call g%fail(e, 'cells', 'expected '//str(ndim)//' cell counts (one per direction), got '// &
@@ -464,10 +472,11 @@ contains
     cs%shape_name = cs%model%shape%name()
   end subroutine read_shape
 
-  subroutine read_particles(path, gs, cs, e)
+  subroutine read_particles(path, gs, cs, ov, e)
     character(len=*), intent(in) :: path
     type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
+    type(empm_overrides_t), intent(in) :: ov
     type(empm_error_t), intent(inout) :: e
     type(empm_param_t), allocatable :: p(:)
     type(empm_group_t) :: g
@@ -528,6 +537,7 @@ contains
       call g%get(p(6), radius, e)
       call g%get(p(7), file, e)
       call g%get(p(8), ppc, e)
+      if (ov%ppc > 0) ppc = ov%ppc
       call g%get(p(9), placement, e)
       call g%get(p(10), velocity, n, e)
       call g%get(p(11), amp, n, e)

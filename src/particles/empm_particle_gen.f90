@@ -1,5 +1,6 @@
 !> Particle generation: fill a box (interval in 1D) or a disk/sphere with n particles per cell
-!> direction, at Gauss–Legendre positions or at cell-centred voxel positions.
+!> direction, at Gauss–Legendre positions or at cell-centred voxel positions; a box face inside
+!> a cell clips that cell's points to the body.
 module empm_particle_gen
   use empm_kinds, only: wp
   use empm_grid, only: empm_grid_t
@@ -13,12 +14,16 @@ module empm_particle_gen
   integer, parameter :: GEOM_DISK = 2    !! disk (2D) or ball (3D) of given centre and radius
   integer, parameter :: PLACE_GAUSS = 1  !! Gauss–Legendre points, volume = Gauss weight share
   integer, parameter :: PLACE_VOXEL = 2  !! centres of ppc^d equal sub-cells (voxels)
+  !> A box face within this fraction of a cell of a grid line is taken to be on it.
+  real(wp), parameter :: SLIVER = 1.0e-9_wp
 
 contains
 
-  !> Append the particles of one body. A candidate point (Gauss or voxel position of a grid
-  !> cell) is kept when it lies inside the geometry; its volume is the cell volume times its
-  !> quadrature weight share, and its half-length is half the voxel size (used by uGIMP).
+  !> Append the particles of one body. A box fills each grid cell it meets with ppc points
+  !> per direction (Gauss or voxel positions) on the part of the cell inside it, so a face
+  !> anywhere in a cell gets the body's exact volume; a disk keeps the points of whole cells
+  !> that lie inside it. A particle's volume is the filled volume times its quadrature weight
+  !> share, and its half-length is half its voxel's size (used by uGIMP).
   !> The particles' state variables start at zero (the model's set-up initialises them).
   subroutine empm_fill(pts, grid, geom, lo, hi, center, radius, ppc, placement, rho, mat, &
                        nadded, info, err)
@@ -38,9 +43,9 @@ contains
     type(empm_error_t), intent(inout), optional :: err !! allocation failure when the storage
                                                        !! grows; without it the program stops
     type(empm_error_t) :: e
-    real(wp) :: xi(4), wi(4), x(3), lp(3), w, cellvol
+    real(wp) :: xi(4), wi(4), x(3), lp(3), w, cellvol, a(3), b(3), wd(3)
     integer :: d, nd, c(3), s(3), cmax(3), k, c1, c2, c3
-    logical :: inside
+    logical :: inside, clip(3)
     nadded = 0; info = 0
     nd = grid%ndim
     if (ppc < 1 .or. ppc > 4) then
@@ -51,15 +56,36 @@ contains
       info = 2; return
     end if
     call points_1d(ppc, placement, xi, wi)
-    cellvol = product(grid%h(1:nd))
-    lp = 0.0_wp
-    lp(1:nd) = 0.5_wp * grid%h(1:nd) / ppc
     cmax = 0; cmax(1:nd) = grid%ncell(1:nd) - 1
     s = 1
     do c3 = 0, cmax(3)
       do c2 = 0, cmax(2)
         do c1 = 0, cmax(1)
           c = [c1, c2, c3]
+          ! The part [a, b] of the cell that the points fill: the whole cell, or for a box
+          ! its intersection with the box, so that a box ending inside a cell gets exactly
+          ! its own volume (its particles shrink with the part of the cell it covers).
+          lp = 0.0_wp; cellvol = 1.0_wp; inside = .true.
+          do d = 1, nd
+            a(d) = grid%origin(d) + c(d) * grid%h(d)
+            wd(d) = grid%h(d)
+            clip(d) = .false.
+            if (geom == GEOM_BOX) then
+              ! A face on a grid line up to round-off leaves no sliver on the far side.
+              b(d) = a(d) + grid%h(d)
+              if (lo(d) > a(d) + SLIVER * grid%h(d)) then
+                a(d) = lo(d); clip(d) = .true.
+              end if
+              if (hi(d) < b(d) - SLIVER * grid%h(d)) then
+                b(d) = hi(d); clip(d) = .true.
+              end if
+              if (b(d) - a(d) <= SLIVER * grid%h(d)) inside = .false.
+              if (clip(d)) wd(d) = b(d) - a(d)
+            end if
+            lp(d) = 0.5_wp * wd(d) / ppc
+            cellvol = cellvol * wd(d)
+          end do
+          if (.not. inside) cycle
           do k = 0, ppc**nd - 1
             ! Sub-point index per direction, x fastest.
             s(1) = 1 + mod(k, ppc)
@@ -67,14 +93,14 @@ contains
             if (nd >= 3) s(3) = 1 + k / (ppc * ppc)
             x = 0.0_wp; w = 1.0_wp
             do d = 1, nd
-              x(d) = grid%origin(d) + (c(d) + 0.5_wp * (1.0_wp + xi(s(d)))) * grid%h(d)
+              if (clip(d)) then
+                x(d) = a(d) + 0.5_wp * (1.0_wp + xi(s(d))) * wd(d)
+              else
+                x(d) = grid%origin(d) + (c(d) + 0.5_wp * (1.0_wp + xi(s(d)))) * grid%h(d)
+              end if
               w = w * wi(s(d))
             end do
-            if (geom == GEOM_BOX) then
-              inside = all(x(1:nd) >= lo(1:nd) .and. x(1:nd) <= hi(1:nd))
-            else
-              inside = sum((x(1:nd) - center(1:nd))**2) <= radius**2
-            end if
+            if (geom == GEOM_DISK) inside = sum((x(1:nd) - center(1:nd))**2) <= radius**2
             if (inside) then
               if (present(err)) then
                 call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat, e)

@@ -590,14 +590,18 @@ contains
     end do
   end subroutine velocity_gradient
 
-  !> out_I = q_I / m_I on nodes with mass above the empty-node threshold, 0 elsewhere.
+  !> out_I = q_I / m_I on nodes with mass above the empty-node threshold, 0 elsewhere; with
+  !> nearly-empty nodes ([[empm_extension]]) their numerators are gathered into their stencils
+  !> and they get the extrapolated values (`nodes%mass` then holds the gathered masses).
   subroutine nodal_divide_by_mass(nodes, q, out)
     type(empm_nodes_t), intent(in) :: nodes           !! nodal fields (mass, mass_tol)
     real(wp), intent(in), contiguous :: q(:,:)        !! nodal vectors (ndim, nnode)
     real(wp), intent(out), contiguous :: out(:,:)     !! q/m (ndim, nnode)
     integer :: I, d
     if (nodes%ndim == 2) then
-      call divide_2d(nodes%nnode, nodes%mass, nodes%mass_tol, q, out); return
+      call divide_2d(nodes%nnode, nodes%mass, nodes%mass_tol, q, out)
+      if (nodes%ext%n > 0) call nodes%ext%correct(nodes%mass, q, out)
+      return
     end if
     !$omp parallel do schedule(static) default(none) shared(nodes, q, out) private(d) &
     !$omp   if(nodes%nnode >= EMPM_OMP_MIN_PARTICLES)
@@ -613,6 +617,7 @@ contains
       end if
     end do
     !$omp end parallel do
+    if (nodes%ext%n > 0) call nodes%ext%correct(nodes%mass, q, out)
   end subroutine nodal_divide_by_mass
 
   !> [[nodal_divide_by_mass]] in 2D (pairs in registers; the same divisions).

@@ -22,6 +22,9 @@ module empm_verify_spec
     integer :: levels(MAXLIST) = 0               !! space study: refinement factors;
                                                  !! stress_point: multipliers of the increments
     real(wp) :: cfls(MAXLIST) = 0.0_wp           !! time study: Courant numbers
+    integer :: nppc = 0                          !! variants in particles per cell (0: the file's)
+    integer :: ppcs(MAXLIST) = 0                 !! particles per cell and direction of each
+                                                 !! variant (every body), label suffix _ppcN
     character(len=32) :: metrics(MAXLIST) = ''   !! matrix study: metric names
     real(wp) :: thresholds(MAXLIST) = 0.0_wp     !! matrix study: upper bounds
     real(wp) :: min_order = 0.0_wp               !! convergence study: required order
@@ -51,26 +54,26 @@ contains
     character(len=:), allocatable, intent(out) :: emsg       !! '' or the problem
     character(len=*), parameter :: K = 'benchmark, study, shapes, schemes, levels, cfls, '// &
       'metrics, thresholds, min_order, max_order, max_error, expect_fail, expect_abort, expect_excess, '// &
-      'expect_order_below, label, quick_levels, quick'
+      'expect_order_below, label, quick_levels, quick, ppcs'
     character(len=32) :: benchmark, metrics(MAXLIST)
     character(len=64) :: expect_fail(MAXLIST)
     character(len=16) :: study, shapes(MAXLIST), schemes(MAXLIST)
     character(len=32) :: label
-    integer :: levels(MAXLIST), quick_levels, u, ios
+    integer :: levels(MAXLIST), quick_levels, u, ios, ppcs(MAXLIST)
     real(wp) :: cfls(MAXLIST), thresholds(MAXLIST), min_order, max_order, expect_excess, &
                 expect_order_below, max_error
     logical :: quick, expect_abort, expects
     character(len=512) :: msg
     namelist /verify/ benchmark, study, shapes, schemes, levels, cfls, metrics, thresholds, &
       min_order, max_order, max_error, expect_fail, expect_abort, expect_excess, expect_order_below, label, &
-      quick_levels, quick
+      quick_levels, quick, ppcs
     emsg = ''
     spec%file = path
     benchmark = ''; study = 'matrix'; shapes = ''; schemes = ''; levels = 0; cfls = 0.0_wp
     metrics = ''; thresholds = -huge(1.0_wp); min_order = -huge(1.0_wp); max_order = huge(1.0_wp)
     max_error = huge(1.0_wp)
     quick_levels = 2; quick = .true.; expect_fail = ''; label = ''; expect_abort = .false.
-    expect_excess = 0.0_wp; expect_order_below = -huge(1.0_wp)
+    expect_excess = 0.0_wp; expect_order_below = -huge(1.0_wp); ppcs = 0
     open(newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) then
       emsg = path//': cannot open: '//trim(msg); return
@@ -95,6 +98,12 @@ contains
     end if
     if (len_trim(benchmark) == 0) then
       emsg = path//': group &verify: key ''benchmark'': required'; return
+    end if
+    spec%nppc = count(ppcs /= 0); spec%ppcs = ppcs
+    if (any(ppcs(1:spec%nppc) < 1 .or. ppcs(1:spec%nppc) > 4) .or. &
+        any(ppcs(spec%nppc + 1:) /= 0)) then
+      emsg = path//': group &verify: key ''ppcs'': particles per cell and direction, 1..4 each'
+      return
     end if
     if (spec%study == 'stress_point') then
       ! A stress-point study (a material point, no grid: no shapes or schemes): metrics with

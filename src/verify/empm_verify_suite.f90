@@ -29,6 +29,7 @@ module empm_verify_suite
     character(len=:), allocatable :: group     !! convergence group id ('' for matrix runs)
     integer :: spec = 0                        !! index of its study
     integer :: ishape = 0, ischeme = 0, ilevel = 0
+    integer :: ippc = 0                        !! particles-per-cell variant (0: the file's)
   end type run_t
 
 contains
@@ -219,6 +220,7 @@ contains
         ok = judged(spec, r%id, ran, passed, val, expected)
       else
       ov%shape = trim(spec%shapes(r%ishape)); ov%scheme = trim(spec%schemes(r%ischeme))
+      if (r%ippc > 0) ov%ppc = spec%ppcs(r%ippc)
       if (spec%study == 'space') ov%refine = spec%levels(r%ilevel)
       if (spec%study == 'time' .and. r%ilevel == 1) then
         ! Temporal errors are measured against a run with the same spatial discretisation and
@@ -505,8 +507,9 @@ contains
     logical, intent(in) :: quick
     type(run_t), allocatable, intent(out) :: runs(:)
     type(run_t), allocatable :: tmp(:)
-    integer :: s, i, j, l, nl, n
+    integer :: s, i, j, l, nl, n, k
     type(run_t) :: r
+    character(len=:), allocatable :: lab
     allocate(runs(0))
     do s = 1, size(specs)
       if (quick .and. .not. specs(s)%quick) cycle
@@ -516,7 +519,7 @@ contains
       if (specs(s)%study == 'stress_point') then
         ! One run per level (increment multiplier); a convergence group when there are levels.
         do l = 1, nl
-          r%spec = s; r%ishape = 0; r%ischeme = 0; r%ilevel = l
+          r%spec = s; r%ishape = 0; r%ischeme = 0; r%ilevel = l; r%ippc = 0
           r%group = ''
           r%id = trim(specs(s)%benchmark)//'/'//trim(specs(s)%label)
           if (specs(s)%nlevel >= 2) then
@@ -528,25 +531,34 @@ contains
         end do
         cycle
       end if
-      do j = 1, specs(s)%nscheme
-        do i = 1, specs(s)%nshape
-          do l = 1, nl
-            r%spec = s; r%ishape = i; r%ischeme = j; r%ilevel = l
-            if (specs(s)%study == 'matrix') then
-              r%group = ''
-              r%id = trim(specs(s)%benchmark)//'/'//trim(specs(s)%schemes(j))//'/'// &
-                trim(specs(s)%shapes(i))
-              if (len_trim(specs(s)%label) > 0) r%id = r%id//'-'//trim(specs(s)%label)
-            else
-              r%group = trim(specs(s)%benchmark)//'/'//trim(specs(s)%study)
-              if (len_trim(specs(s)%label) > 0) r%group = r%group//'_'//trim(specs(s)%label)
-              r%group = r%group//'/'// &
-                trim(specs(s)%schemes(j))//'/'//trim(specs(s)%shapes(i))
-              r%id = r%group//'/'//str(l)
-            end if
-            n = size(runs)
-            allocate(tmp(n + 1)); tmp(1:n) = runs; tmp(n + 1) = r
-            call move_alloc(tmp, runs)
+      do k = 0, specs(s)%nppc
+        if (k == 0 .and. specs(s)%nppc > 0) cycle
+        ! The label, with the particles-per-cell variant as a suffix.
+        lab = trim(specs(s)%label)
+        if (k > 0) then
+          if (len(lab) > 0) lab = lab//'_'
+          lab = lab//'ppc'//str(specs(s)%ppcs(k))
+        end if
+        do j = 1, specs(s)%nscheme
+          do i = 1, specs(s)%nshape
+            do l = 1, nl
+              r%spec = s; r%ishape = i; r%ischeme = j; r%ilevel = l; r%ippc = k
+              if (specs(s)%study == 'matrix') then
+                r%group = ''
+                r%id = trim(specs(s)%benchmark)//'/'//trim(specs(s)%schemes(j))//'/'// &
+                  trim(specs(s)%shapes(i))
+                if (len(lab) > 0) r%id = r%id//'-'//lab
+              else
+                r%group = trim(specs(s)%benchmark)//'/'//trim(specs(s)%study)
+                if (len(lab) > 0) r%group = r%group//'_'//lab
+                r%group = r%group//'/'// &
+                  trim(specs(s)%schemes(j))//'/'//trim(specs(s)%shapes(i))
+                r%id = r%group//'/'//str(l)
+              end if
+              n = size(runs)
+              allocate(tmp(n + 1)); tmp(1:n) = runs; tmp(n + 1) = r
+              call move_alloc(tmp, runs)
+            end do
           end do
         end do
       end do
