@@ -159,12 +159,10 @@ def convergence_section(conv, name, title, exact):
 
 
 def free_end_section(s):
-    """The vibrating bar with its free end a fraction f of a cell past a grid line
-    (vibrating_bar_end*.nml) and the free-free control: the observed order of every shape,
-    per end fraction and particles per cell, in one figure and one table."""
-    conv = [c for c in s["convergence"]
-            if c["id"].startswith("vibrating_bar/space_end") or
-            c["id"].startswith("vibrating_bar/space_free_free")]
+    """The vibrating bar with its free end a fraction f of a cell past a grid line and its fixed
+    end a mirror plane (vibrating_bar_end*.nml): the observed order of every shape, per end
+    fraction and particles per cell, in one figure and one table."""
+    conv = [c for c in s["convergence"] if c["id"].startswith("vibrating_bar/space_end")]
     if not conv:
         return []
     def key(c):
@@ -173,13 +171,11 @@ def free_end_section(s):
         return end, int(ppc), shape
     shapes = sorted({key(c)[2] for c in conv},
                     key=lambda x: (not x.startswith("lme"), float(x[5:]) if x.startswith("lme") else 0, x))
-    ends = sorted({key(c)[0] for c in conv}, key=lambda e: (e == "free_free", e))
+    ends = sorted({key(c)[0] for c in conv})
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2), sharey=True)
     for ax, ppc in zip(axes, (1, 2)):
         for k, end in enumerate(ends):
             col, ls, mk = STYLES[k % len(STYLES)]
-            if end == "free_free":
-                col, mk = "k", "x"
             xs, ys, hollow = [], [], []
             for i, shp in enumerate(shapes):
                 c = next((c for c in conv if key(c) == (end, ppc, shp)), None)
@@ -187,8 +183,7 @@ def free_end_section(s):
                     continue
                 xs.append(i + 0.08 * (k - len(ends) / 2)); ys.append(c["observed_order"])
                 hollow.append(bool(c.get("expected_failure")))
-            lab = ("free-free control, ends ¼ cell past a grid line" if end == "free_free"
-                   else f"free end {int(end[3:]) / 100:g} cell past a grid line")
+            lab = f"free end {int(end[3:]) / 100:g} cell past a grid line"
             ax.plot(xs, ys, color=col, ls="none", marker=mk, ms=6, label=lab,
                     mfc="none" if all(hollow) and hollow else col)
             for x, y, h in zip(xs, ys, hollow):
@@ -207,10 +202,10 @@ def free_end_section(s):
            f"![free end]({savefig(fig, 'vibrating_bar_free_end.png')})", "",
            "*Observed order of the RMS velocity error at t = 5T/4 between the two finest "
            "levels (h₀/17, h₀/33 with h₀ = 25/(6 + f)), per shape, with the free end a fraction "
-           "f of a cell past a grid line at every level (docs/free-surfaces.md).* Exact: the "
-           "first mode of the continuous bar at the particles' reference positions. Dashed: the "
-           "required 1.8; circled: the known failure (LME γ = 0.8, one particle per cell, the "
-           "Dirichlet end: the free-free control, black crosses, converges at 2.0).", "",
+           "f of a cell past a grid line at every level, and the fixed end a mirror plane "
+           "(docs/free-surfaces.md).* Exact: the first mode of the continuous bar at the "
+           "particles' reference positions. Dashed: the required 1.8; circled: a known "
+           "failure, if any.", "",
            "| shape | " + " | ".join(f"{e} ppc{p}" for e in ends for p in (1, 2)) + " |",
            "|---|" + "---|" * (2 * len(ends))]
     for shp in shapes:

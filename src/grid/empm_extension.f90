@@ -17,8 +17,8 @@
 !> extended basis: masses and the numerators of every nodal division are gathered with the
 !> transposed coefficients (m̂ = Eᵀm), the divisions are done on the other nodes, and the
 !> degenerate nodes then get their extrapolated values (v = E v̂). The switch is sharp (a
-!> partial share kept by nodes filled just under θ brings the failure back: measured on
-!> vibrating_bar_end25_lme.nml). A stencil that would take more than half of a
+!> partial share kept by nodes filled just under θ brings the failure back: measured on the
+!> free end ¼ of a cell past a grid line). A stencil that would take more than half of a
 !> neighbour's mass falls back to the constant extension v_I = v_J; a node with no usable node
 !> within `REACH` steps (a small fragment) stays an ordinary node.
 module empm_extension

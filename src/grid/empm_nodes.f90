@@ -24,6 +24,14 @@ module empm_nodes
     real(wp), allocatable :: vol(:)         !! filled volume Σ N_Ip V_p (nnode) [m^ndim], for
                                             !! the extension of nearly-empty nodes
     type(empm_extension_t) :: ext           !! nearly-empty nodes of the current basis
+    ! Mirror planes (`&boundary mirror`): ghost node ghost(k) takes msign(d, k) times the value
+    ! of its image image(k) across the plane; its mass and numerators are gathered into the
+    ! image (docs/free-surfaces.md, "Mirror planes").
+    integer :: nmirror = 0                          !! ghost/image pairs
+    integer, allocatable :: ghost(:)                !! ghost nodes (nmirror)
+    integer, allocatable :: image(:)                !! their images (nmirror)
+    real(wp), allocatable :: msign(:,:)             !! −1 (odd) or +1 (even) per component
+                                                    !! (ndim, nmirror)
     ! The constraints are private: `fixed_dofs` must follow `fixed`, so they change only
     ! through fix_box/fix_dof, and are read through is_fixed/fixed_velocity/nfixed.
     logical, allocatable, private :: fixed(:,:)     !! Dirichlet mask per dof (ndim, nnode)
@@ -54,6 +62,10 @@ module empm_nodes
     procedure :: compute_reactions => nodes_compute_reactions
     procedure :: local_damping => nodes_local_damping
     procedure :: find_degenerate => nodes_find_degenerate
+    procedure :: mirror_box => nodes_mirror_box
+    procedure :: mirror_gather_mass => nodes_mirror_gather_mass
+    procedure :: mirror_correct => nodes_mirror_correct
+    procedure :: mirror_scatter => nodes_mirror_scatter
     procedure, private :: list_fixed => nodes_list_fixed
   end type empm_nodes_t
 
@@ -91,7 +103,105 @@ contains
     call zero(self%force, d * n); call zero(self%acc, d * n); call zero(self%work, d * n)
     call zero(self%vol, n)
     call self%ext%init(n)
+    self%nmirror = 0
+    if (allocated(self%ghost)) deallocate(self%ghost, self%image, self%msign)
+    allocate(self%ghost(0), self%image(0), self%msign(d, 0))
   end subroutine nodes_alloc
+
+  !> A mirror plane: the nodes in the box [lo, hi], which must be flat along axis |side| (the
+  !> plane, on a grid line), get components `comp` fixed at zero; every node on the ghost side
+  !> of the plane (sign of `side`) whose foot lies in the box becomes the ghost of its mirror
+  !> image, with value −v (the `comp` components: odd about the plane) or +v (the others: even).
+  !> Gathering the ghosts' masses and numerators into their images is what the mirror
+  !> particles of the symmetric problem would give them. `info`: 0 ok, 1 box not flat along
+  !> the axis or not on a grid line, 2 no plane node, 3 a ghost node fixed or already a ghost,
+  !> 4 no ghost node (the grid ends at the plane).
+  subroutine nodes_mirror_box(self, grid, lo, hi, side, comp, nsel, info)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields
+    type(empm_grid_t), intent(in) :: grid      !! background grid
+    real(wp), intent(in) :: lo(3), hi(3)       !! box of the plane's nodes [m]
+    integer, intent(in) :: side                !! ±axis: the ghost side (e.g. -1: x below)
+    logical, intent(in) :: comp(3)             !! odd (fixed on the plane) components
+    integer, intent(out) :: nsel               !! plane nodes selected
+    integer, intent(out) :: info               !! status (above)
+    real(wp) :: xi(3), tol, zero3(3)
+    integer :: a, id, k, ijk(3), g(3), m(3), ip, nd, d, ng
+    integer, allocatable :: gh(:), im(:)
+    real(wp), allocatable :: sg(:,:)
+    info = 0; nd = grid%ndim; a = abs(side); zero3 = 0.0_wp
+    tol = 1.0e-9_wp * grid%hmin()
+    ip = nint((lo(a) - grid%origin(a)) * grid%inv_h(a))
+    if (abs(hi(a) - lo(a)) > tol .or. abs(grid%origin(a) + ip * grid%h(a) - lo(a)) > tol) then
+      info = 1; return
+    end if
+    call self%fix_box(grid, lo, hi, comp, zero3, nsel)
+    if (nsel == 0) then
+      info = 2; return
+    end if
+    allocate(gh(0), im(0), sg(nd, 0))
+    ng = 0
+    do id = 1, grid%nnode
+      xi = grid%node_coord(id)
+      if (.not. all(xi(1:nd) >= lo(1:nd) - tol .and. xi(1:nd) <= hi(1:nd) + tol)) cycle
+      ijk = grid%node_ijk(id)
+      do k = 1, grid%nn(a)
+        g = ijk; g(a) = ijk(a) + sign(k, side)
+        m = ijk; m(a) = ijk(a) - sign(k, side)
+        if (g(a) < 0 .or. g(a) > grid%nn(a) - 1 .or. m(a) < 0 .or. m(a) > grid%nn(a) - 1) exit
+        if (any(self%fixed(:, grid%node_id(g))) .or. any(gh == grid%node_id(g)) .or. &
+            any(self%ghost == grid%node_id(g))) then
+          info = 3; return
+        end if
+        gh = [gh, grid%node_id(g)]; im = [im, grid%node_id(m)]
+        sg = reshape([sg, [(merge(-1.0_wp, 1.0_wp, comp(d)), d = 1, nd)]], [nd, size(gh)])
+        ng = ng + 1
+      end do
+    end do
+    if (ng == 0) then
+      info = 4; return
+    end if
+    self%ghost = [self%ghost, gh]; self%image = [self%image, im]
+    self%msign = reshape([self%msign, sg], [nd, size(self%ghost)])
+    self%nmirror = size(self%ghost)
+  end subroutine nodes_mirror_box
+
+  !> m_image += m_ghost, m_ghost = 0 (the ghosts are not unknowns).
+  subroutine nodes_mirror_gather_mass(self)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields
+    integer :: k
+    do k = 1, self%nmirror
+      self%mass(self%image(k)) = self%mass(self%image(k)) + self%mass(self%ghost(k))
+      self%mass(self%ghost(k)) = 0.0_wp
+    end do
+  end subroutine nodes_mirror_gather_mass
+
+  !> After out = q/m̂: the images get their ghosts' numerators with the component signs,
+  !> out_J += s q_I/m̂_J (free dofs only), and the ghosts their mirrored values.
+  subroutine nodes_mirror_correct(self, q, out)
+    class(empm_nodes_t), intent(in) :: self     !! nodal fields (gathered masses)
+    real(wp), intent(in) :: q(:,:)              !! numerators (ndim, nnode)
+    real(wp), intent(inout) :: out(:,:)         !! q/m̂ (ndim, nnode)
+    integer :: k, d, J
+    do k = 1, self%nmirror
+      J = self%image(k)
+      if (.not. self%mass(J) > self%mass_tol) cycle
+      do d = 1, self%ndim
+        if (.not. self%fixed(d, J)) out(d, J) = out(d, J) + self%msign(d, k) * q(d, self%ghost(k)) &
+                                                / self%mass(J)
+      end do
+    end do
+    call self%mirror_scatter(out)
+  end subroutine nodes_mirror_correct
+
+  !> v_ghost = s v_image.
+  subroutine nodes_mirror_scatter(self, v)
+    class(empm_nodes_t), intent(in) :: self     !! nodal fields
+    real(wp), intent(inout) :: v(:,:)           !! nodal vectors (ndim, nnode)
+    integer :: k
+    do k = 1, self%nmirror
+      v(:, self%ghost(k)) = self%msign(:, k) * v(:, self%image(k))
+    end do
+  end subroutine nodes_mirror_scatter
 
   !> The nearly-empty nodes of a new basis ([[empm_extension]]), from the nodal masses and the
   !> filled volumes `vol` just accumulated; a node with a fixed dof is never one.
@@ -286,7 +396,8 @@ contains
     real(wp), intent(inout), contiguous :: mom(:,:)   !! nodal momenta (ndim, nnode)
     call constrain_dofs(size(self%fixed_dofs), self%fixed_dofs, self%ndim, self%mass, &
                         self%vfix, v, mom)
-    ! Nearly-empty nodes extrapolate from the constrained values.
+    ! Ghosts and nearly-empty nodes take their values from the constrained ones.
+    if (self%nmirror > 0) call self%mirror_scatter(v)
     if (self%ext%n > 0) call self%ext%scatter(v)
   end subroutine nodes_constrain_velocity
 

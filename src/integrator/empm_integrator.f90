@@ -256,14 +256,16 @@ contains
     self%basis_ready = .true.
   end subroutine carry_basis
 
-  !> After the nodal masses were accumulated: with the extension of nearly-empty nodes on
-  !> ([[empm_extension]]), find them when the basis is new (`fresh`; their filled volumes in
-  !> one more P2G) and gather the masses, m̂ = Eᵀm. Without degenerate nodes nothing changes.
+  !> After the nodal masses were accumulated: mirror ghosts' masses go to their images; with the
+  !> extension of nearly-empty nodes on ([[empm_extension]]), find them when the basis is new
+  !> (`fresh`; their filled volumes in one more P2G) and gather the masses, m̂ = Eᵀm. Without
+  !> mirrors and degenerate nodes nothing changes.
   subroutine extend_masses(self, model, fresh)
     class(empm_integrator_t), intent(inout) :: self   !! integrator (P2G workspace)
     type(empm_model_t), intent(inout) :: model        !! simulation state
     logical, intent(in) :: fresh                      !! the basis was just evaluated
     associate (nodes => model%nodes)
+      if (nodes%nmirror > 0) call nodes%mirror_gather_mass()
       if (nodes%ext%theta <= 0.0_wp) return
       if (fresh) then
         nodes%vol = 0.0_wp

@@ -151,7 +151,12 @@ contains
         empm_param('velocity', PARAM_REAL, 'm/s', 'prescribed velocity of the fixed components', &
           default='0', count=3, lo=-LMAX, hi=LMAX), &
         empm_param('name', PARAM_STR, '-', 'record the reaction force of this node set as '// &
-          '/history/reaction/<name> (unique)', optional=.true.)]
+          '/history/reaction/<name> (unique)', optional=.true.), &
+        empm_param('mirror', PARAM_STR, '-', 'a mirror plane: the box is flat along this '// &
+          'axis (a grid line), its nodes get the fix components fixed at zero, and the nodes '// &
+          'on the given side of it are ghosts with the mirrored values (fix components odd, '// &
+          'the others even): a fixed end with symmetric supports (docs/free-surfaces.md)', &
+          default='''none''', choices='none -x +x -y +y -z +z')]
     case ('traction')
       p = [ &
         empm_param('name', PARAM_STR, '-', 'label (messages)', optional=.true.), &
@@ -841,7 +846,7 @@ contains
     real(wp) :: lo(3), hi(3), velocity(3)
     logical :: fix(3)
     integer :: nb, nsel, nd, k, nlo, nhi, n
-    character(len=:), allocatable :: name
+    character(len=:), allocatable :: name, mirror
     allocate(p, source=empm_input_group_params('boundary'))
     nd = cs%model%grid%ndim
     call cs%model%nodes%alloc(cs%model%grid)
@@ -858,6 +863,8 @@ contains
       call g%get(p(4), velocity, n, e)
       name = ''
       call g%get(p(5), name, e)
+      mirror = 'none'
+      call g%get(p(6), mirror, e)
       if (e%code /= EMPM_OK) return
       if (g%has('name')) then
         if (.not. valid_name(name)) then
@@ -876,6 +883,11 @@ contains
         call g%fail(e, 'fix', 'expected at least one .true. component (boundary '//str(nb)//')')
         return
       end if
+      if (mirror /= 'none') then
+        call read_mirror(g, cs, lo, hi, fix, velocity, trim(mirror), nb, e)
+        if (e%code /= EMPM_OK) return
+        cycle
+      end if
       if (g%has('name')) then
         call cs%model%nodes%fix_box(cs%model%grid, lo, hi, fix, velocity, nsel, name)
       else
@@ -887,6 +899,57 @@ contains
       end if
     end do
   end subroutine read_boundaries
+
+  ! A mirror-plane boundary (`mirror = '-x'` ...): checks, the plane and its ghosts, and no
+  ! particle on the ghost side.
+  subroutine read_mirror(g, cs, lo, hi, fix, velocity, mirror, nb, e)
+    type(empm_group_t), intent(inout) :: g
+    type(empm_case_t), intent(inout) :: cs
+    real(wp), intent(in) :: lo(3), hi(3), velocity(3)
+    logical, intent(in) :: fix(3)
+    character(len=*), intent(in) :: mirror
+    integer, intent(in) :: nb
+    type(empm_error_t), intent(inout) :: e
+    integer :: a, side, nsel, info, p, np
+    real(wp) :: plane, tol
+    a = index('xyz', mirror(2:2)); side = merge(-a, a, mirror(1:1) == '-')
+    if (a > cs%model%grid%ndim) then
+      call g%fail(e, 'mirror', 'axis '''//mirror(2:2)//''' beyond ndim = '// &
+        str(cs%model%grid%ndim)); return
+    end if
+    if (any(fix .and. velocity /= 0.0_wp)) then
+      call g%fail(e, 'velocity', 'a mirror plane is at rest: the fixed components must be 0 '// &
+        '(boundary '//str(nb)//')'); return
+    end if
+    if (g%has('name')) then
+      call g%fail(e, 'name', 'reaction sets are not recorded on mirror planes (boundary '// &
+        str(nb)//')'); return
+    end if
+    call cs%model%nodes%mirror_box(cs%model%grid, lo, hi, side, fix, nsel, info)
+    select case (info)
+    case (1)
+      call g%fail(e, 'lo', 'a mirror box must be flat along '//mirror(2:2)//' (lo = hi) and '// &
+        'on a grid line (nodes lie at origin + i*h) (boundary '//str(nb)//')'); return
+    case (2)
+      call g%fail(e, 'lo', 'the box [lo, hi] selects no grid node (boundary '//str(nb)//')')
+      return
+    case (3)
+      call g%fail(e, 'mirror', 'a ghost node on the '//mirror//' side is fixed by another '// &
+        '&boundary or is already a ghost (boundary '//str(nb)//')'); return
+    case (4)
+      call g%fail(e, 'mirror', 'no ghost node: the grid must continue past the plane on the '// &
+        mirror//' side, by the shape functions'' reach (boundary '//str(nb)//')'); return
+    end select
+    ! The ghost side must hold no particle (the mirror stands for the body's image there).
+    plane = lo(a); tol = 1.0e-9_wp * cs%model%grid%h(a)
+    np = cs%model%pts%np
+    do p = 1, np
+      if (sign(1.0_wp, real(side, wp)) * (cs%model%pts%x(a, p) - plane) > tol) then
+        call g%fail(e, 'mirror', 'particle '//str(p)//' lies on the ghost side '//mirror// &
+          ' of the plane at '//str_short(plane)//' m (boundary '//str(nb)//')'); return
+      end if
+    end do
+  end subroutine read_mirror
 
   !> A name that can be an HDF5 group: 1..64 of NAME_CHARS, not '.' or '..'.
   pure logical function valid_name(name)

@@ -600,6 +600,7 @@ contains
     integer :: I, d
     if (nodes%ndim == 2) then
       call divide_2d(nodes%nnode, nodes%mass, nodes%mass_tol, q, out)
+      if (nodes%nmirror > 0) call nodes%mirror_correct(q, out)
       if (nodes%ext%n > 0) call nodes%ext%correct(nodes%mass, q, out)
       return
     end if
@@ -617,6 +618,7 @@ contains
       end if
     end do
     !$omp end parallel do
+    if (nodes%nmirror > 0) call nodes%mirror_correct(q, out)
     if (nodes%ext%n > 0) call nodes%ext%correct(nodes%mass, q, out)
   end subroutine nodal_divide_by_mass
 
