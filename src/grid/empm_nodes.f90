@@ -32,6 +32,9 @@ module empm_nodes
     integer, allocatable :: image(:)                !! their images (nmirror)
     real(wp), allocatable :: msign(:,:)             !! −1 (odd) or +1 (even) per component
                                                     !! (ndim, nmirror)
+    integer :: nplane = 0                           !! mirror planes
+    integer, allocatable :: plane_side(:)           !! ±axis of each plane's ghost side
+    real(wp), allocatable :: plane_at(:)            !! its coordinate [m]
     ! The constraints are private: `fixed_dofs` must follow `fixed`, so they change only
     ! through fix_box/fix_dof, and are read through is_fixed/fixed_velocity/nfixed.
     logical, allocatable, private :: fixed(:,:)     !! Dirichlet mask per dof (ndim, nnode)
@@ -103,9 +106,10 @@ contains
     call zero(self%force, d * n); call zero(self%acc, d * n); call zero(self%work, d * n)
     call zero(self%vol, n)
     call self%ext%init(n)
-    self%nmirror = 0
-    if (allocated(self%ghost)) deallocate(self%ghost, self%image, self%msign)
-    allocate(self%ghost(0), self%image(0), self%msign(d, 0))
+    self%nmirror = 0; self%nplane = 0
+    if (allocated(self%ghost)) deallocate(self%ghost, self%image, self%msign, self%plane_side, &
+                                          self%plane_at)
+    allocate(self%ghost(0), self%image(0), self%msign(d, 0), self%plane_side(0), self%plane_at(0))
   end subroutine nodes_alloc
 
   !> A mirror plane: the nodes in the box [lo, hi], which must be flat along axis |side| (the
@@ -163,6 +167,8 @@ contains
     self%ghost = [self%ghost, gh]; self%image = [self%image, im]
     self%msign = reshape([self%msign, sg], [nd, size(self%ghost)])
     self%nmirror = size(self%ghost)
+    self%plane_side = [self%plane_side, side]; self%plane_at = [self%plane_at, lo(a)]
+    self%nplane = size(self%plane_side)
   end subroutine nodes_mirror_box
 
   !> m_image += m_ghost, m_ghost = 0 (the ghosts are not unknowns).

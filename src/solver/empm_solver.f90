@@ -542,6 +542,16 @@ contains
             vec(pts%x(:, p))
           return
         end if
+        ! The ghost side of a mirror plane stands for the body's image: no particle may enter it.
+        do I = 1, model%nodes%nplane
+          if (sign(1.0_wp, real(model%nodes%plane_side(I), wp)) * (pts%x(abs(model%nodes% &
+              plane_side(I)), p) - model%nodes%plane_at(I)) > &
+              1.0e-9_wp * model%grid%h(abs(model%nodes%plane_side(I)))) then
+            msg = 'step '//str(model%step)//': particle '//str(p)//' crossed the mirror plane '// &
+              'at '//str(model%nodes%plane_at(I))//' m: x = '//vec(pts%x(:, p))
+            return
+          end if
+        end do
       end do
     end associate
     do I = 1, model%nodes%nnode
