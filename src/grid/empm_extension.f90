@@ -9,7 +9,7 @@
 !>
 !>     φ_I = Σ_p N_Ip V_p / h^d < θ,
 !>
-!> and it has no fixed dof. Its value is extrapolated linearly from the nearest free, well-filled
+!> and it has no fixed dof (nor is a mirror plane's image node). Its value is extrapolated linearly from the nearest free, well-filled
 !> node J (Euclidean distance in grid steps, then the largest φ) and J's free neighbour one step
 !> further into the body along each direction of the offset,
 !> v_I = (1 + Σ|o_d|) v_J − Σ |o_d| v_{J − sgn(o_d) e_d}, o = I − J (grid steps): linear fields
@@ -68,13 +68,15 @@ contains
   !> Find the degenerate nodes and their stencils from the nodal masses and filled volumes of
   !> a new basis. `fixed(d, I)`: dof d of node I is prescribed. The lists grow only when a basis
   !> has more degenerate nodes than any before (no allocation in a steady run).
-  subroutine ext_find(self, grid, mass, vol, mass_tol, fixed)
+  subroutine ext_find(self, grid, mass, vol, mass_tol, fixed, keep)
     class(empm_extension_t), intent(inout) :: self !! extension
     type(empm_grid_t), intent(in) :: grid          !! background grid
     real(wp), intent(in) :: mass(:)                !! lumped nodal masses (nnode) [kg]
     real(wp), intent(in) :: vol(:)                 !! filled volumes Σ N_Ip V_p (nnode) [m^d]
     real(wp), intent(in) :: mass_tol               !! lighter nodes are empty [kg]
     logical, intent(in) :: fixed(:,:)              !! Dirichlet mask (ndim, nnode)
+    logical, intent(in) :: keep(:)                 !! nodes never degenerate (mirror images,
+                                                   !! whose ghosts take their values) (nnode)
     real(wp) :: vcut, best
     integer :: I, J, K, c, nd, r, ijk(3), q(3), o(3), lo(3), hi(3), a, b, e, cnt, dist, dbest
     nd = grid%ndim
@@ -83,7 +85,8 @@ contains
     vcut = self%theta * product(grid%h(1:nd))
     cnt = 0
     do I = 1, grid%nnode
-      self%deg(I) = mass(I) > mass_tol .and. vol(I) < vcut .and. .not. any(fixed(:, I))
+      self%deg(I) = mass(I) > mass_tol .and. vol(I) < vcut .and. .not. any(fixed(:, I)) &
+                    .and. .not. keep(I)
       if (self%deg(I)) cnt = cnt + 1
     end do
     if (cnt == 0) return

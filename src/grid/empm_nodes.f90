@@ -32,6 +32,7 @@ module empm_nodes
     integer, allocatable :: image(:)                !! their images (nmirror)
     real(wp), allocatable :: msign(:,:)             !! −1 (odd) or +1 (even) per component
                                                     !! (ndim, nmirror)
+    logical, allocatable :: mirrored(:)             !! node is a ghost's image (nnode)
     integer :: nplane = 0                           !! mirror planes
     integer, allocatable :: plane_side(:)           !! ±axis of each plane's ghost side
     real(wp), allocatable :: plane_at(:)            !! its coordinate [m]
@@ -110,6 +111,9 @@ contains
     if (allocated(self%ghost)) deallocate(self%ghost, self%image, self%msign, self%plane_side, &
                                           self%plane_at)
     allocate(self%ghost(0), self%image(0), self%msign(d, 0), self%plane_side(0), self%plane_at(0))
+    if (allocated(self%mirrored)) deallocate(self%mirrored)
+    allocate(self%mirrored(n))
+    self%mirrored = .false.
   end subroutine nodes_alloc
 
   !> A mirror plane: the nodes in the box [lo, hi], which must be flat along axis |side| (the
@@ -167,6 +171,7 @@ contains
     self%ghost = [self%ghost, gh]; self%image = [self%image, im]
     self%msign = reshape([self%msign, sg], [nd, size(self%ghost)])
     self%nmirror = size(self%ghost)
+    self%mirrored(im) = .true.
     self%plane_side = [self%plane_side, side]; self%plane_at = [self%plane_at, lo(a)]
     self%nplane = size(self%plane_side)
   end subroutine nodes_mirror_box
@@ -210,11 +215,12 @@ contains
   end subroutine nodes_mirror_scatter
 
   !> The nearly-empty nodes of a new basis ([[empm_extension]]), from the nodal masses and the
-  !> filled volumes `vol` just accumulated; a node with a fixed dof is never one.
+  !> filled volumes `vol` just accumulated; a node with a fixed dof, or a mirror image (its
+  !> ghosts take their values from it and hand it their numerators), is never one.
   subroutine nodes_find_degenerate(self, grid)
     class(empm_nodes_t), intent(inout) :: self !! nodal fields
     type(empm_grid_t), intent(in) :: grid      !! background grid
-    call self%ext%find(grid, self%mass, self%vol, self%mass_tol, self%fixed)
+    call self%ext%find(grid, self%mass, self%vol, self%mass_tol, self%fixed, self%mirrored)
   end subroutine nodes_find_degenerate
 
   !> Zero the fields P2G accumulates into, mass and momentum (step 9 of the paper's
