@@ -68,6 +68,7 @@ module empm_nodes
     procedure :: find_degenerate => nodes_find_degenerate
     procedure :: mirror_box => nodes_mirror_box
     procedure :: mirror_gather_mass => nodes_mirror_gather_mass
+    procedure :: mirror_gather_even => nodes_mirror_gather_even
     procedure :: mirror_correct => nodes_mirror_correct
     procedure :: mirror_scatter => nodes_mirror_scatter
     procedure, private :: list_fixed => nodes_list_fixed
@@ -179,12 +180,26 @@ contains
   !> m_image += m_ghost, m_ghost = 0 (the ghosts are not unknowns).
   subroutine nodes_mirror_gather_mass(self)
     class(empm_nodes_t), intent(inout) :: self !! nodal fields
-    integer :: k
-    do k = 1, self%nmirror
-      self%mass(self%image(k)) = self%mass(self%image(k)) + self%mass(self%ghost(k))
-      self%mass(self%ghost(k)) = 0.0_wp
-    end do
+    call gather_even(self%nmirror, self%ghost, self%image, self%mass)
   end subroutine nodes_mirror_gather_mass
+
+  !> A nodal scalar even about the mirror planes (a mass-like sum, e.g. of the volumetric
+  !> rate): a_image += a_ghost, a_ghost = 0.
+  subroutine nodes_mirror_gather_even(self, a)
+    class(empm_nodes_t), intent(in) :: self     !! nodal fields
+    real(wp), intent(inout) :: a(:)             !! nodal scalars (nnode)
+    call gather_even(self%nmirror, self%ghost, self%image, a)
+  end subroutine nodes_mirror_gather_even
+
+  pure subroutine gather_even(n, ghost, image, a)
+    integer, intent(in) :: n, ghost(:), image(:)
+    real(wp), intent(inout) :: a(:)
+    integer :: k
+    do k = 1, n
+      a(image(k)) = a(image(k)) + a(ghost(k))
+      a(ghost(k)) = 0.0_wp
+    end do
+  end subroutine gather_even
 
   !> After out = q/m̂: the images get their ghosts' numerators with the component signs,
   !> out_J += s q_I/m̂_J (free dofs only), and the ghosts their mirrored values.
@@ -204,13 +219,21 @@ contains
     call self%mirror_scatter(out)
   end subroutine nodes_mirror_correct
 
-  !> v_ghost = s v_image.
-  subroutine nodes_mirror_scatter(self, v)
+  !> v_ghost = s v_image (with `even`, v_ghost = v_image in every row).
+  subroutine nodes_mirror_scatter(self, v, even)
     class(empm_nodes_t), intent(in) :: self     !! nodal fields
-    real(wp), intent(inout) :: v(:,:)           !! nodal vectors (ndim, nnode)
+    real(wp), intent(inout) :: v(:,:)           !! nodal vectors (ndim or 1, nnode)
+    logical, intent(in), optional :: even       !! an even field (default: the plane's signs)
     integer :: k
+    logical :: ev
+    ev = .false.
+    if (present(even)) ev = even
     do k = 1, self%nmirror
-      v(:, self%ghost(k)) = self%msign(:, k) * v(:, self%image(k))
+      if (ev) then
+        v(:, self%ghost(k)) = v(:, self%image(k))
+      else
+        v(:, self%ghost(k)) = self%msign(:, k) * v(:, self%image(k))
+      end if
     end do
   end subroutine nodes_mirror_scatter
 

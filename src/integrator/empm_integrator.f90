@@ -516,13 +516,8 @@ contains
     call p2g_mass(model%basis, integ%vs_w(1:np), integ%vs_q, integ%p2g)
     ! Mirror planes: the volumetric rate is even about the plane, so a ghost's share adds to its
     ! image and the ghost takes the image's value.
-    associate (nodes => model%nodes)
-      do k = 1, nodes%nmirror
-        integ%vs_mass(nodes%image(k)) = integ%vs_mass(nodes%image(k)) + integ%vs_mass(nodes%ghost(k))
-        integ%vs_q(nodes%image(k)) = integ%vs_q(nodes%image(k)) + integ%vs_q(nodes%ghost(k))
-        integ%vs_mass(nodes%ghost(k)) = 0.0_wp
-      end do
-    end associate
+    call model%nodes%mirror_gather_even(integ%vs_mass)
+    call model%nodes%mirror_gather_even(integ%vs_q)
     do I = 1, size(integ%vs_mass)
       if (integ%vs_mass(I) > model%nodes%mass_tol) then
         integ%vs_node(:, I) = integ%vs_q(I) / integ%vs_mass(I)
@@ -530,9 +525,7 @@ contains
         integ%vs_node(:, I) = 0.0_wp
       end if
     end do
-    do k = 1, model%nodes%nmirror
-      integ%vs_node(:, model%nodes%ghost(k)) = integ%vs_node(:, model%nodes%image(k))
-    end do
+    call model%nodes%mirror_scatter(integ%vs_node, even=.true.)
     call g2p_value(model%basis, integ%vs_node, integ%vs_bar)
   end subroutine smooth_volumetric
 
