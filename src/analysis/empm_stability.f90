@@ -19,8 +19,10 @@
 !> State vector per particle z = (σ_p/(ρc), v_p, a_p h/c). Before each probe step the particle
 !> positions, densities and volumes are reset to the reference configuration, which freezes
 !> the linearisation point (shape functions and volumes at t = 0). What is left nonlinear in
-!> one step is only the volume change V = m/ρ multiplying the new stress (a bilinear term);
-!> it is removed exactly by differencing the steps from +εe_j and −εe_j.
+!> one step is the volume change V = m/ρ multiplying the new stress and, for `pc_newmark`,
+!> the basis at the drifted positions and its trapezoidal gradient: the even terms cancel in
+!> the symmetric difference of the steps from +εe_j and −εe_j, and the O(ε²) error of the odd
+!> (cubic) ones by Richardson extrapolation over ε and ε/2.
 module empm_stability
   use empm_kinds, only: wp
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
@@ -41,10 +43,9 @@ module empm_stability
   public :: STAB_RHO_TOL
 
   !> A spectral radius up to 1 + STAB_RHO_TOL counts as stable. The allowance covers round-off
-  !> and the probe's own nonlinearity: schemes that form a^{n+1} with the basis of x^{n+1}
-  !> (pc_newmark) move the particles by Δt·v = O(AMP) before the last G2P, which leaves
-  !> O(AMP²) = 1e-12 in the symmetric differences (ρ − 1 measured 2e-14 at CFL 0.5, 5.4e-12 at
-  !> 2.0 on the lattice). A real instability exceeds it at once (ρ − 1 = 0.26 at CFL 2.02).
+  !> and what is left of the probe's own nonlinearity (schemes that form a^{n+1} with the basis
+  !> of x^{n+1}, pc_newmark, move the particles by Δt·v = O(AMP) within the step; see
+  !> [[probe_matrix]]). A real instability exceeds it at once (ρ − 1 = 0.26 at CFL 2.02).
   real(wp), parameter :: STAB_RHO_TOL = 1.0e-10_wp
 
   real(wp), parameter :: E_MOD = 1.0_wp  ! Young's modulus of the probe models
@@ -354,24 +355,30 @@ contains
     info = 0
   end subroutine probe_build
 
-  ! Amplification matrix by symmetric differences of single steps from ±AMP·e_j.
+  ! Amplification matrix by symmetric differences of single steps from ±ε·e_j, ε = AMP and
+  ! AMP/2, extrapolated: D(ε) = A e_j + O(ε²) (a step is a polynomial of low degree in the
+  ! state once the positions are reset), so (4 D(ε/2) − D(ε))/3 = A e_j + O(ε⁴).
   subroutine probe_matrix(pr, dt, A, info)
     type(probe_t), intent(inout) :: pr
     real(wp), intent(in) :: dt
     real(wp), intent(out) :: A(:,:)
     integer, intent(out) :: info
-    real(wp) :: z(size(A, 1)), zp(size(A, 1)), zm(size(A, 1))
-    integer :: j
+    real(wp) :: z(size(A, 1)), zp(size(A, 1)), zm(size(A, 1)), d(size(A, 1), 2), eps
+    integer :: j, k
     A = 0.0_wp
     do j = 1, size(A, 2)
-      z = 0.0_wp
-      z(j) = AMP
-      call probe_step(pr, dt, z, zp, info)
-      if (info /= 0) return
-      z(j) = -AMP
-      call probe_step(pr, dt, z, zm, info)
-      if (info /= 0) return
-      A(:, j) = (zp - zm) / (2.0_wp * AMP)
+      do k = 1, 2
+        eps = AMP / k
+        z = 0.0_wp
+        z(j) = eps
+        call probe_step(pr, dt, z, zp, info)
+        if (info /= 0) return
+        z(j) = -eps
+        call probe_step(pr, dt, z, zm, info)
+        if (info /= 0) return
+        d(:, k) = (zp - zm) / (2.0_wp * eps)
+      end do
+      A(:, j) = (4.0_wp * d(:, 2) - d(:, 1)) / 3.0_wp
     end do
   end subroutine probe_matrix
 

@@ -11,10 +11,12 @@ module empm_integrator
   use empm_namelist, only: empm_group_t
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_SHAPE_FAILED, &
                         STEP_MATERIAL_FAILED
-  use empm_transfer, only: p2g_mass, p2g_mass_momentum, p2g_internal_force, p2g_body_force, &
-                           nodal_divide_by_mass, g2p_value, &
+  use empm_transfer, only: p2g_mass, p2g_mass_momentum, p2g_weighted, p2g_internal_force, &
+                           p2g_body_force, &
+                           nodal_divide_by_mass, g2p_value, g2p_add_scaled, &
                            velocity_gradient, empm_p2g_work_t
-  use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID
+  use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_STRESS, &
+                        PHASE_G2P
   use empm_material, only: empm_material_ctx_t
   use empm_shape, only: BASIS_Q4, basis_q4_weights
   use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds, &
@@ -22,7 +24,7 @@ module empm_integrator
   implicit none
   private
   public :: empm_integrator_t, eval_basis, map_velocity, update_stress, initial_acceleration
-  public :: carry_basis, particle_axpy
+  public :: particle_gradients, particle_axpy, drift_prepare, drift_begin, drift_end
 
   !> Particles per material call in [[update_stress]]: their L, F, strain and stress fit in
   !> the L1 cache together.
@@ -49,14 +51,18 @@ module empm_integrator
                                          !! row (ndim, np)
     type(empm_p2g_work_t) :: p2g         !! per-thread P2G buffers (sized in `prepare`)
     type(empm_phase_timer_t) :: timer    !! wall time per phase of the step, Newton iterations
-    logical :: basis_ready = .false.     !! model%basis is at the particles' current positions
-                                         !! (evaluated at the end of the last step by
-                                         !! [[carry_basis]]): the next step reuses it
+    logical :: basis_ready = .false.     !! model%basis and the nodal masses are at the
+                                         !! particles' current positions (evaluated at the end
+                                         !! of the last step, [[drift_end]]): the next step's
+                                         !! [[map_velocity]] reuses them
     logical :: carry = .false.           !! the scheme carries the basis of x^{n+1} into the
                                          !! next step (set by the scheme's `start`)
     logical :: reeval = .false.          !! the particles were put back (restart, replay): the
                                          !! next evaluation repeats the one that made the
                                          !! carried basis, from the multipliers it started from
+    real(wp), allocatable :: l0(:,:,:)   !! schemes with a trapezoidal drift: the gradient of
+                                         !! the drift over the basis of x^n per particle
+                                         !! (ndim, ndim, np; [[drift_begin]], [[drift_end]])
   contains
     procedure(step_iface), deferred :: step
     procedure :: name => integrator_name
@@ -238,24 +244,6 @@ contains
     end if
   end subroutine eval_basis
 
-  !> End of a step for schemes that need the basis of x^{n+1} (a^{n+1} on the grid the
-  !> particles now see): the shape functions at the new positions and the nodal masses, timed
-  !> as the shape and P2G phases. The next step reuses the basis ([[map_velocity]]), so a
-  !> scheme still evaluates it once per step. On a shape failure `stat` says which particle.
-  subroutine carry_basis(self, model, stat)
-    class(empm_integrator_t), intent(inout) :: self   !! integrator (timer, P2G workspace)
-    type(empm_model_t), intent(inout) :: model        !! simulation state
-    type(empm_step_status_t), intent(inout) :: stat   !! set on failure
-    call eval_basis(model, stat, self%timer, self%p2g)
-    call self%timer%lap(PHASE_SHAPE)
-    if (stat%code /= 0) return
-    ! nodes%vel keeps the step's velocities (local damping reads them).
-    call model%nodes%reset()
-    call p2g_mass(model%basis, model%pts%m, model%nodes%mass, self%p2g)
-    call extend_masses(self, model, .true.)
-    self%basis_ready = .true.
-  end subroutine carry_basis
-
   !> After the nodal masses were accumulated: mirror ghosts' masses go to their images; with the
   !> extension of nearly-empty nodes on ([[empm_extension]]), find them when the basis is new
   !> (`fresh`; their filled volumes in one more P2G) and gather the masses, m̂ = Eᵀm. Without
@@ -307,8 +295,9 @@ contains
   !> The opening of every scheme's step, timed as its shape, P2G and grid phases: shape
   !> functions at the particles; mass and mass-weighted velocity v_p + c w_p on the grid in one
   !> pass (without `c` and `w`: the momentum); nodal velocity = that / mass with the Dirichlet
-  !> values imposed (nodes%vel, and nodes%mom to match). On a shape failure `stat` says which
-  !> particle and nothing else is done.
+  !> values imposed (nodes%vel, and nodes%mom to match). With a carried basis (`basis_ready`)
+  !> its nodal masses are kept and only the momentum is mapped. On a shape failure `stat` says
+  !> which particle and nothing else is done.
   subroutine map_velocity(self, model, stat, c, w)
     class(empm_integrator_t), intent(inout) :: self   !! integrator (timer, P2G workspace)
     type(empm_model_t), intent(inout) :: model        !! simulation state
@@ -320,21 +309,29 @@ contains
       call tm%mark()
       fresh = .not. self%basis_ready
       if (self%basis_ready) then
+        ! The carried basis came with its nodal masses (extended and gathered): only the
+        ! momentum is new.
         self%basis_ready = .false.
+        nodes%mom = 0.0_wp
+        if (present(c) .and. present(w)) then
+          call p2g_weighted(basis, pts%m, pts%v, c, w, nodes%mom, self%p2g)
+        else
+          call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom, self%p2g)
+        end if
       else
         call eval_basis(model, stat, tm, self%p2g, self%reeval)
         self%reeval = .false.
         call tm%lap(PHASE_SHAPE)
         if (stat%code /= 0) return
+        call nodes%reset()
+        if (present(c) .and. present(w)) then
+          call p2g_mass_momentum(basis, pts%m, pts%v, c, w, nodes%mass, nodes%mom, self%p2g)
+        else
+          call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
+                                 self%p2g)
+        end if
+        call extend_masses(self, model, fresh)
       end if
-      call nodes%reset()
-      if (present(c) .and. present(w)) then
-        call p2g_mass_momentum(basis, pts%m, pts%v, c, w, nodes%mass, nodes%mom, self%p2g)
-      else
-        call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
-                               self%p2g)
-      end if
-      call extend_masses(self, model, fresh)
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
       call nodes%constrain_velocity(nodes%vel, nodes%mom)
@@ -461,23 +458,183 @@ contains
   !> particle is replaced by its mass-weighted nodal average ([[smooth_volumetric]]) before the
   !> material call: L_p += (ē_p − tr L_p)/ndim · I on the in-plane (2D) or full (3D) diagonal,
   !> the deviatoric part of L_p unchanged. Without it the update is unchanged, bit for bit.
-  subroutine update_stress(model, vel, dt, stat, integ)
+  subroutine update_stress(model, vel, dt, stat, integ, lprev)
     type(empm_model_t), intent(inout) :: model      !! simulation state
     real(wp), intent(in), contiguous :: vel(:,:)    !! nodal velocities defining L (ndim, nnode)
     real(wp), intent(in) :: dt                      !! time step [s]
     type(empm_step_status_t), intent(inout) :: stat !! set on failure
     class(empm_integrator_t), intent(inout), optional :: integ !! the scheme (smoothing option
                                                     !! and its scratch)
-    real(wp) :: none1(0), none2(0, 0)
-    if (present(integ)) then
-      if (integ%vol_smooth) then
-        call smooth_volumetric(integ, model, vel)
-        call stress_blocks(model, vel, dt, stat, .true., integ%vs_tr, integ%vs_bar)
-        return
-      end if
+    real(wp), intent(in), contiguous, optional :: lprev(:,:,:) !! with it, the particles' L at
+                                                    !! the start of the step (3, 3, np): the
+                                                    !! material gets the trapezoidal gradient
+                                                    !! of [[trapezoid_gradient]]
+    real(wp) :: none1(0), none2(0, 0), none3(0, 0, 0)
+    logical :: sm, tz
+    sm = .false.
+    if (present(integ)) sm = integ%vol_smooth
+    tz = present(lprev)
+    if (sm .and. tz) then
+      call smooth_volumetric(integ, model, vel, lprev, dt)
+      call stress_blocks(model, vel, dt, stat, .true., integ%vs_tr, integ%vs_bar, .true., lprev)
+    else if (sm) then
+      call smooth_volumetric(integ, model, vel, none3, dt)
+      call stress_blocks(model, vel, dt, stat, .true., integ%vs_tr, integ%vs_bar, .false., none3)
+    else if (tz) then
+      call stress_blocks(model, vel, dt, stat, .false., none1, none2, .true., lprev)
+    else
+      call stress_blocks(model, vel, dt, stat, .false., none1, none2, .false., none3)
     end if
-    call stress_blocks(model, vel, dt, stat, .false., none1, none2)
   end subroutine update_stress
+
+  !> For a scheme with a trapezoidal drift (its `start`): the basis of x^{n+1} is carried
+  !> into the next step, and the drift's gradient has its array.
+  subroutine drift_prepare(self, model)
+    class(empm_integrator_t), intent(inout) :: self !! integrator
+    type(empm_model_t), intent(in) :: model         !! simulation state
+    self%carry = .true.
+    if (allocated(self%l0)) deallocate(self%l0)
+    allocate(self%l0(model%grid%ndim, model%grid%ndim, model%pts%np))
+  end subroutine drift_prepare
+
+  !> The first half of a trapezoidal drift over the bases of x^n and x^{n+1}
+  !> (docs/integrators.md, "Why the drift is trapezoidal"), before the particles move by
+  !> Δt G2P(v)_p: keep L⁰ = Σ v_I ⊗ ∇N_Ip, add the correction left by the last step to x, and
+  !> keep the resulting start positions in `pts%dx` ([[drift_end]] forms the next correction
+  !> from them). `v` is the grid velocity field whose interpolation moves the particles.
+  subroutine drift_begin(self, model, v)
+    class(empm_integrator_t), intent(inout) :: self  !! integrator (l0)
+    type(empm_model_t), intent(inout) :: model       !! simulation state
+    real(wp), intent(in), contiguous :: v(:,:)       !! v_I (ndim, nnode)
+    integer :: np
+    call particle_gradients(model, v, self%l0)
+    np = model%pts%np
+    call shift_keep(np, model%pts%x, model%pts%dx)
+  end subroutine drift_begin
+
+  !> x += dx, then dx = x (the start positions of a trapezoidal drift).
+  subroutine shift_keep(np, x, dx)
+    integer, intent(in) :: np                        !! number of particles
+    real(wp), intent(inout), contiguous :: x(:,:)    !! positions (ndim, >= np)
+    real(wp), intent(inout), contiguous :: dx(:,:)   !! corrections in, start positions out
+    integer :: p
+    !$omp parallel do default(none) shared(np, x, dx) schedule(static) &
+    !$omp   if(np >= EMPM_OMP_MIN_PARTICLES)
+    do p = 1, np
+      x(:, p) = x(:, p) + dx(:, p)
+      dx(:, p) = x(:, p)
+    end do
+    !$omp end parallel do
+  end subroutine shift_keep
+
+  !> dx = ½(dx − x): with dx the start positions, −½ of the displacement since.
+  subroutine half_back(np, x, dx)
+    integer, intent(in) :: np                        !! number of particles
+    real(wp), intent(in), contiguous :: x(:,:)       !! positions (ndim, >= np)
+    real(wp), intent(inout), contiguous :: dx(:,:)   !! start positions in, −½ displacement out
+    integer :: p
+    !$omp parallel do default(none) shared(np, x, dx) schedule(static) &
+    !$omp   if(np >= EMPM_OMP_MIN_PARTICLES)
+    do p = 1, np
+      dx(:, p) = 0.5_wp * (dx(:, p) - x(:, p))
+    end do
+    !$omp end parallel do
+  end subroutine half_back
+
+  !> The second half of the trapezoidal drift, after the particles moved: the basis at x^{n+1}
+  !> (the step's one evaluation, carried into the next step), the particle velocities `pts%v`
+  !> mapped on it (u_I in `nodes%vel`), the stress with the trapezoidal gradient of L⁰ and
+  !> L¹ = Σ u_I ⊗ ∇N_Ip(x^{n+1}) ([[trapezoid_gradient]]), and the correction
+  !> dx_p = ½Δt (G2P(u)_p − G2P(v)_p) for the next drift. `pts%v` must be the particle values
+  !> that `v` of [[drift_begin]] was mapped from. On failure `stat` says why.
+  subroutine drift_end(self, model, dt, stat)
+    class(empm_integrator_t), intent(inout) :: self  !! integrator (l0, timer)
+    type(empm_model_t), intent(inout) :: model       !! simulation state
+    real(wp), intent(in) :: dt                       !! time step [s]
+    type(empm_step_status_t), intent(inout) :: stat  !! set on failure
+    integer :: np
+    np = model%pts%np
+    self%basis_ready = .false.
+    call map_velocity(self, model, stat)
+    if (stat%code /= 0) return
+    self%basis_ready = .true.
+    call update_stress(model, model%nodes%vel, dt, stat, self, self%l0)
+    call self%timer%lap(PHASE_STRESS)
+    if (stat%code /= 0) return
+    ! dx = ½Δt (G2P(u)_p − G2P(v)_p), the second from the displacement: ½(x_start − x).
+    call half_back(np, model%pts%x, model%pts%dx)
+    call g2p_add_scaled(model%basis, 0.5_wp * dt, model%nodes%vel, model%pts%dx)
+    call self%timer%lap(PHASE_G2P)
+  end subroutine drift_end
+
+  !> The velocity gradients L_p = Σ_I v_I ⊗ ∇N_Ip of every particle, for a scheme that combines
+  !> two of them in one stress update (only the ndim × ndim part: less memory traffic).
+  subroutine particle_gradients(model, vel, lg)
+    type(empm_model_t), intent(in) :: model          !! simulation state (basis)
+    real(wp), intent(in), contiguous :: vel(:,:)     !! nodal velocities (ndim, nnode)
+    real(wp), intent(inout), contiguous :: lg(:,:,:) !! gradients (ndim, ndim, >= np)
+    real(wp) :: Lb(3, 3, STRESS_BLOCK)
+    integer :: np, nc, c, a, b, q0, q1, d, p
+    np = model%pts%np; d = model%grid%ndim
+    nc = empm_chunks(np)
+    !$omp parallel do default(none) schedule(static, 1) shared(model, vel, lg, np, nc, d) &
+    !$omp& private(a, b, q0, q1, p, Lb) if(nc > 1)
+    do c = 0, nc - 1
+      call empm_chunk_bounds(np, nc, c, a, b)
+      do q0 = a, b, STRESS_BLOCK
+        q1 = min(b, q0 + STRESS_BLOCK - 1)
+        call velocity_gradient(model%basis, vel, q0, q1, Lb)
+        select case (d)
+        case (1)
+          lg(1, 1, q0:q1) = Lb(1, 1, 1:q1 - q0 + 1)
+        case (2)
+          do p = q0, q1
+            lg(1, 1, p) = Lb(1, 1, p - q0 + 1); lg(2, 1, p) = Lb(2, 1, p - q0 + 1)
+            lg(1, 2, p) = Lb(1, 2, p - q0 + 1); lg(2, 2, p) = Lb(2, 2, p - q0 + 1)
+          end do
+        case default
+          lg(:, :, q0:q1) = Lb(:, :, 1:q1 - q0 + 1)
+        end select
+      end do
+    end do
+    !$omp end parallel do
+  end subroutine particle_gradients
+
+  !> L := ½(L⁰ + L) + ½Δt L L⁰ for a block of particles: with L⁰ the gradient of the drift's
+  !> velocity field on the basis of x^n and L that of the same particle velocities on the basis
+  !> of x^{n+1}, I + Δt L is ½[I + (I + Δt L)(I + Δt L⁰)], the deformation gradient of the
+  !> trapezoidal (Heun) drift (docs/integrators.md, "Temporal order at large motion").
+  pure subroutine trapezoid_gradient(dt, l0, L)
+    real(wp), intent(in) :: dt                      !! time step [s]
+    real(wp), intent(in), contiguous :: l0(:,:,:)   !! gradients at the start of the step
+                                                    !! (d, d, n)
+    real(wp), intent(inout), contiguous :: L(:,:,:) !! gradients at the end (3, 3, >= n; the
+                                                    !! d × d part is used); the combination
+    real(wp) :: a11, a21, a12, a22, b11, b21, b12, b22, g(3, 3), h
+    integer :: p
+    h = 0.5_wp * dt
+    ! One branch per dimension: constant bounds, no temporaries.
+    select case (size(l0, 1))
+    case (1)
+      do p = 1, size(l0, 3)
+        L(1, 1, p) = 0.5_wp * (l0(1, 1, p) + L(1, 1, p)) + h * L(1, 1, p) * l0(1, 1, p)
+      end do
+    case (2)
+      do p = 1, size(l0, 3)
+        a11 = l0(1, 1, p); a21 = l0(2, 1, p); a12 = l0(1, 2, p); a22 = l0(2, 2, p)
+        b11 = L(1, 1, p); b21 = L(2, 1, p); b12 = L(1, 2, p); b22 = L(2, 2, p)
+        L(1, 1, p) = 0.5_wp * (a11 + b11) + h * (b11 * a11 + b12 * a21)
+        L(2, 1, p) = 0.5_wp * (a21 + b21) + h * (b21 * a11 + b22 * a21)
+        L(1, 2, p) = 0.5_wp * (a12 + b12) + h * (b11 * a12 + b12 * a22)
+        L(2, 2, p) = 0.5_wp * (a22 + b22) + h * (b21 * a12 + b22 * a22)
+      end do
+    case (3)
+      do p = 1, size(l0, 3)
+        g = 0.5_wp * (l0(:, :, p) + L(:, :, p)) + h * matmul(L(:, :, p), l0(:, :, p))
+        L(:, :, p) = g
+      end do
+    end select
+  end subroutine trapezoid_gradient
 
   !> Nodal averaging of the volumetric strain rate (a B-bar/F-bar-like projection for MPM):
   !> ē_I = Σ_p N_Ip m_p tr L_p / Σ_p N_Ip m_p on every node with mass, then
@@ -485,15 +642,21 @@ contains
   !> removes the volumetric locking of isochoric (plastic, φ = ψ = 0) flow with several particles
   !> per cell; a uniform tr L is reproduced (partition of unity), up to round-off. Results:
   !> `integ%vs_tr` (tr L_p) and `integ%vs_bar` (ē_p in every row).
-  subroutine smooth_volumetric(integ, model, vel)
+  subroutine smooth_volumetric(integ, model, vel, lprev, dt)
     class(empm_integrator_t), intent(inout) :: integ !! the scheme (scratch, P2G workspace)
     type(empm_model_t), intent(inout) :: model       !! simulation state
     real(wp), intent(in), contiguous :: vel(:,:)     !! nodal velocities (ndim, nnode)
+    real(wp), intent(in), contiguous :: lprev(:,:,:) !! empty, or the gradients at the start of
+                                                     !! the step ([[trapezoid_gradient]])
+    real(wp), intent(in) :: dt                       !! time step [s]
     real(wp) :: Lb(3, 3, STRESS_BLOCK)
     integer :: np, d, nc, c, a, b, q0, q1, p, k, I
+    logical :: tz
     np = model%pts%np; d = model%grid%ndim
     nc = empm_chunks(np)
-    !$omp parallel do default(none) schedule(static, 1) shared(model, vel, integ, np, nc, d) &
+    tz = size(lprev) > 0
+    !$omp parallel do default(none) schedule(static, 1) &
+    !$omp& shared(model, vel, integ, np, nc, d, lprev, dt, tz) &
     !$omp& private(a, b, q0, q1, p, k, Lb) if(nc > 1)
     do c = 0, nc - 1
       call empm_chunk_bounds(np, nc, c, a, b)
@@ -501,6 +664,7 @@ contains
       do q0 = a, b, STRESS_BLOCK
         q1 = min(b, q0 + STRESS_BLOCK - 1)
         call velocity_gradient(model%basis, vel, q0, q1, Lb)
+        if (tz) call trapezoid_gradient(dt, lprev(:, :, q0:q1), Lb)
         do p = q0, q1
           integ%vs_tr(p) = 0.0_wp
           do k = 1, d
@@ -529,15 +693,17 @@ contains
     call g2p_value(model%basis, integ%vs_node, integ%vs_bar)
   end subroutine smooth_volumetric
 
-  !> The block loop of [[update_stress]]; with `sm`, L_p's volumetric part is replaced by
+  !> The block loop of [[update_stress]]; with `tz`, L_p is first combined with `lprev`
+  !> ([[trapezoid_gradient]]); with `sm`, its volumetric part is then replaced by
   !> ē_p = `bar(1, p)` (`tr(p)` = tr L_p) before the material call.
-  subroutine stress_blocks(model, vel, dt, stat, sm, tr, bar)
+  subroutine stress_blocks(model, vel, dt, stat, sm, tr, bar, tz, lprev)
     type(empm_model_t), intent(inout) :: model
     real(wp), intent(in), contiguous :: vel(:,:)
     real(wp), intent(in) :: dt
     type(empm_step_status_t), intent(inout) :: stat
-    logical, intent(in) :: sm
+    logical, intent(in) :: sm, tz
     real(wp), intent(in) :: tr(:), bar(:,:)
+    real(wp), intent(in), contiguous :: lprev(:,:,:)
     real(wp) :: Lb(3, 3, STRESS_BLOCK), dv
     integer :: r, i0, i1, info, im, n, nc, c, a, b, q0, q1, bad, p, k
     type(empm_material_ctx_t) :: ctx
@@ -551,7 +717,7 @@ contains
       ! The first failing particle of the run, whichever block it is in.
       bad = huge(1)
       !$omp parallel do default(none) schedule(static, 1) &
-      !$omp& shared(model, vel, dt, i0, im, n, nc, sm, tr, bar) &
+      !$omp& shared(model, vel, dt, i0, im, n, nc, sm, tr, bar, tz, lprev) &
       !$omp& private(a, b, q0, q1, p, k, dv, Lb, info) firstprivate(ctx) reduction(min: bad) &
       !$omp& if(nc > 1)
       do c = 0, nc - 1
@@ -561,6 +727,7 @@ contains
         do q0 = a, b, STRESS_BLOCK
           q1 = min(b, q0 + STRESS_BLOCK - 1)
           call velocity_gradient(model%basis, vel, q0, q1, Lb)
+          if (tz) call trapezoid_gradient(dt, lprev(:, :, q0:q1), Lb)
           if (sm) then
             do p = q0, q1
               dv = (bar(1, p) - tr(p)) / ctx%ndim

@@ -9,16 +9,18 @@
 !> 6. pc_published: f_I at t+Δt from the new stresses (basis of x^n), zero on fixed dofs;
 !>    a_I = f_I/m_I; corrector v_I = v*_I + γ Δt a_I;
 !>    a_p = Σ N a_I, v_p += Δt a_p, x_p += Δt Σ N v_I + ½Δt² Σ N a_I
-!> 7. pc_newmark, drift: x_p += Δt Σ N v*_I + (γ − ½)Δt² a_p, v_p += (1−γ)Δt a_p; then the
-!>    basis at x^{n+1} (kept for the next step), m_I and f_I at t+Δt on it, a_I = f_I/m_I;
-!>    kick: a_p = Σ N a_I, v_p += γΔt a_p
+!> 7. pc_newmark (steps 4–5 move after the drift), drift: L⁰_p = Σ v*_I ⊗ ∇N_Ip kept;
+!>    x_p += dx_p + Δt Σ N v*_I + (γ − ½)Δt² a_p, v_p += (1−γ)Δt a_p; then the basis at x^{n+1}
+!>    (kept for the next step), the same particle velocities mapped on it (u_I); the stress
+!>    with the trapezoidal gradient of L⁰ and L_p = Σ u_I ⊗ ∇N_Ip; dx_p = ½Δt Σ N (u_I − v*_I)
+!>    for the next drift; f_I at t+Δt, a_I = f_I/m_I; kick: a_p = Σ N a_I, v_p += γΔt a_p
 module empm_integrator_pc
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t
   use empm_params, only: empm_param_t, empm_param, PARAM_REAL
   use empm_namelist, only: empm_group_t
   use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration, &
-                             carry_basis, particle_axpy
+                             drift_prepare, drift_begin, drift_end, particle_axpy
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: g2p_add_scaled, g2p_value, nodal_divide_by_mass
   use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
@@ -89,7 +91,7 @@ contains
   subroutine pc_start(self, model)
     class(empm_pc_t), intent(inout) :: self     !! integrator
     type(empm_model_t), intent(inout) :: model  !! simulation state
-    self%carry = self%variant == PC_NEWMARK
+    if (self%variant == PC_NEWMARK) call drift_prepare(self, model)
     call initial_acceleration(self, model)
   end subroutine pc_start
 
@@ -105,11 +107,11 @@ contains
       ! Predictor v*_I, formed from particle data (eq. 31) to avoid dividing accelerations.
       call map_velocity(self, model, stat, (1.0_wp - g) * dt, pts%a)
       if (stat%code /= STEP_OK) return
-      ! Strain increment and stress with the predicted velocity.
-      call update_stress(model, nodes%vel, dt, stat, self)
-      call tm%lap(PHASE_STRESS)
-      if (stat%code /= STEP_OK) return
       if (self%variant == PC_PUBLISHED) then
+        ! Strain increment and stress with the predicted velocity.
+        call update_stress(model, nodes%vel, dt, stat, self)
+        call tm%lap(PHASE_STRESS)
+        if (stat%code /= STEP_OK) return
         ! Balance of forces at t + Δt with the basis of x^n, as published; nodes%acc = f/m
         ! (zero on fixed dofs).
         call self%assemble_forces(model, model%t + dt)
@@ -123,15 +125,18 @@ contains
         call g2p_value(basis, nodes%acc, pts%a)
         pts%v(:, 1:pts%np) = pts%v(:, 1:pts%np) + dt * pts%a(:, 1:pts%np)
       else
-        ! Newmark β = 0, drift: x uses v* (the displacement step 4 strained with) and a_p^n.
-        call g2p_add_scaled(basis, dt, nodes%vel, pts%x)
+        ! Newmark β = 0: drift with the predictor v* (the particles' v + (1−γ)Δt a mapped on
+        ! the basis of x^n), trapezoidal over the bases of x^n and x^{n+1} (the projection
+        ! particles → grid → particles moves with the particles; docs/integrators.md), then
+        ! the stress with the drift's deformation gradient.
         call particle_axpy(pts%np, (g - 0.5_wp) * dt * dt, pts%a, pts%x)
+        call drift_begin(self, model, nodes%vel)
+        call g2p_add_scaled(basis, dt, nodes%vel, pts%x)
         call particle_axpy(pts%np, (1.0_wp - g) * dt, pts%a, pts%v)
         call tm%lap(PHASE_G2P)
-        ! Kick with the basis of x^{n+1}: a^{n+1} = f(σ^{n+1}, t + Δt)/m on the grid the
-        ! particles now see (the basis then serves the next step too: one evaluation per step).
-        call carry_basis(self, model, stat)
+        call drift_end(self, model, dt, stat)
         if (stat%code /= STEP_OK) return
+        ! Kick: a^{n+1} = f(σ^{n+1}, t + Δt)/m on the grid the particles now see.
         call self%assemble_forces(model, model%t + dt)
         call tm%lap(PHASE_P2G)
         call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)

@@ -22,6 +22,10 @@ module empm_particles
     real(wp), allocatable :: x0(:,:)        !! reference (initial) position (ndim, np) [m]
     real(wp), allocatable :: v(:,:)         !! velocity (ndim, np) [m/s]
     real(wp), allocatable :: a(:,:)         !! acceleration (ndim, np) [m/s²]
+    real(wp), allocatable :: dx(:,:)        !! position correction still to apply (ndim, np)
+                                            !! [m]: the trapezoidal term of the last
+                                            !! `pc_newmark` drift, added by the next one
+                                            !! (docs/integrators.md); zero for other schemes
     real(wp), allocatable :: m(:)           !! mass (np) [kg]
     real(wp), allocatable :: vol(:)         !! current volume (np) [m³]
     real(wp), allocatable :: vol0(:)        !! initial volume (np) [m³]
@@ -71,18 +75,20 @@ contains
     self%nstate = ns
     call release(self)
     st = 0; msg = ''
-    allocate(self%x(ndim, n), self%x0(ndim, n), self%v(ndim, n), self%a(ndim, n), &
+    allocate(self%x(ndim, n), self%x0(ndim, n), self%v(ndim, n), self%a(ndim, n), self%dx(ndim, n), &
       self%m(n), self%vol(n), self%vol0(n), self%rho(n), self%stress(6, n), self%strain(6, n), &
       self%F(3, 3, n), self%lp(ndim, n), self%lam(ndim, n), &
       self%lam_old(ndim, n), self%lam_prev(ndim, n), self%lam_old_prev(ndim, n), self%mat(n), &
       self%state(ns, n), stat=st, errmsg=msg)
     if (st /= 0) then
       call release(self)
-      ! 9 vectors, 4 scalars, 2 Voigt tensors, F and the state in reals; the material index.
-      bytes = int(n, int64) * (8_int64 * (9 * ndim + 4 + 12 + 9 + int(ns, int64)) + 4_int64)
+      ! 10 vectors, 4 scalars, 2 Voigt tensors, F and the state in reals; the material index.
+      bytes = int(n, int64) * (8_int64 * (10 * ndim + 4 + 12 + 9 + int(ns, int64)) + 4_int64)
       call empm_raise_error(empm_alloc_error('particle storage ('//str(n)//' particles)', &
         bytes, trim(msg)), err)
+      return
     end if
+    self%dx = 0.0_wp ! particles filled in place (not appended) have no pending correction
   end subroutine particles_alloc
 
   !> Give every particle `nstate` state variables, all zero (set-up; the model calls it with
@@ -115,6 +121,7 @@ contains
     if (allocated(self%x0)) deallocate(self%x0)
     if (allocated(self%v)) deallocate(self%v)
     if (allocated(self%a)) deallocate(self%a)
+    if (allocated(self%dx)) deallocate(self%dx)
     if (allocated(self%m)) deallocate(self%m)
     if (allocated(self%vol)) deallocate(self%vol)
     if (allocated(self%vol0)) deallocate(self%vol0)
@@ -164,7 +171,7 @@ contains
     self%np = n
     d = self%ndim
     self%x(:, n) = x(1:d); self%x0(:, n) = x(1:d)
-    self%v(:, n) = 0.0_wp; self%a(:, n) = 0.0_wp
+    self%v(:, n) = 0.0_wp; self%a(:, n) = 0.0_wp; self%dx(:, n) = 0.0_wp
     self%vol(n) = vol; self%vol0(n) = vol; self%rho(n) = rho; self%m(n) = rho * vol
     self%stress(:, n) = 0.0_wp; self%strain(:, n) = 0.0_wp
     self%F(:, :, n) = 0.0_wp; self%F(1, 1, n) = 1.0_wp; self%F(2, 2, n) = 1.0_wp
@@ -190,6 +197,7 @@ contains
     if (src%nstate > 0) self%state(:, 1:n) = src%state(:, 1:n)
     self%x(:, 1:n) = src%x(:, 1:n); self%x0(:, 1:n) = src%x0(:, 1:n)
     self%v(:, 1:n) = src%v(:, 1:n); self%a(:, 1:n) = src%a(:, 1:n)
+    self%dx(:, 1:n) = src%dx(:, 1:n)
     self%m(1:n) = src%m(1:n); self%vol(1:n) = src%vol(1:n); self%vol0(1:n) = src%vol0(1:n)
     self%rho(1:n) = src%rho(1:n)
     self%stress(:, 1:n) = src%stress(:, 1:n); self%strain(:, 1:n) = src%strain(:, 1:n)
@@ -217,6 +225,7 @@ contains
     to%np = from%np
     call move_alloc(from%x, to%x); call move_alloc(from%x0, to%x0)
     call move_alloc(from%v, to%v); call move_alloc(from%a, to%a)
+    call move_alloc(from%dx, to%dx)
     call move_alloc(from%m, to%m); call move_alloc(from%vol, to%vol)
     call move_alloc(from%vol0, to%vol0); call move_alloc(from%rho, to%rho)
     call move_alloc(from%stress, to%stress); call move_alloc(from%strain, to%strain)
