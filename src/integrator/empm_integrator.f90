@@ -13,7 +13,7 @@ module empm_integrator
                         STEP_MATERIAL_FAILED
   use empm_transfer, only: p2g_mass, p2g_mass_momentum, p2g_weighted, p2g_internal_force, &
                            p2g_body_force, &
-                           nodal_divide_by_mass, g2p_value, g2p_add_scaled, &
+                           nodal_divide_by_mass, g2p_value, g2p_block, &
                            velocity_gradient, empm_p2g_work_t
   use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_STRESS, &
                         PHASE_G2P
@@ -24,7 +24,7 @@ module empm_integrator
   implicit none
   private
   public :: empm_integrator_t, eval_basis, map_velocity, update_stress, initial_acceleration
-  public :: particle_gradients, particle_axpy, drift_prepare, drift_begin, drift_end
+  public :: particle_axpy, drift_prepare, drift_begin, drift_end
 
   !> Particles per material call in [[update_stress]]: their L, F, strain and stress fit in
   !> the L1 cache together.
@@ -498,48 +498,107 @@ contains
   end subroutine drift_prepare
 
   !> The first half of a trapezoidal drift over the bases of x^n and x^{n+1}
-  !> (docs/integrators.md, "Why the drift is trapezoidal"), before the particles move by
-  !> Δt G2P(v)_p: keep L⁰ = Σ v_I ⊗ ∇N_Ip, add the correction left by the last step to x, and
-  !> keep the resulting start positions in `pts%dx` ([[drift_end]] forms the next correction
-  !> from them). `v` is the grid velocity field whose interpolation moves the particles.
-  subroutine drift_begin(self, model, v)
+  !> (docs/integrators.md, "Why the drift is trapezoidal"): keep L⁰ = Σ v_I ⊗ ∇N_Ip, add the
+  !> correction left by the last step to x, keep the resulting start positions in `pts%dx`
+  !> ([[drift_end]] forms the next correction from them) and move the particles by
+  !> Δt G2P(v)_p. `v` is the grid velocity field whose interpolation moves the particles. One
+  !> pass, block by block, so that each block's basis is read from cache the second time.
+  subroutine drift_begin(self, model, v, dt)
     class(empm_integrator_t), intent(inout) :: self  !! integrator (l0)
     type(empm_model_t), intent(inout) :: model       !! simulation state
     real(wp), intent(in), contiguous :: v(:,:)       !! v_I (ndim, nnode)
-    integer :: np
-    call particle_gradients(model, v, self%l0)
-    np = model%pts%np
-    call shift_keep(np, model%pts%x, model%pts%dx)
+    real(wp), intent(in) :: dt                       !! time step [s]
+    real(wp) :: Lb(3, 3, STRESS_BLOCK)
+    integer :: np, nc, c, a, b, q0, q1, d
+    np = model%pts%np; d = model%grid%ndim
+    nc = empm_chunks(np)
+    !$omp parallel do default(none) schedule(static, 1) shared(model, self, v, dt, np, nc, d) &
+    !$omp& private(a, b, q0, q1, Lb) if(nc > 1)
+    do c = 0, nc - 1
+      call empm_chunk_bounds(np, nc, c, a, b)
+      do q0 = a, b, STRESS_BLOCK
+        q1 = min(b, q0 + STRESS_BLOCK - 1)
+        call velocity_gradient(model%basis, v, q0, q1, Lb)
+        call keep_gradients(d, q0, q1, Lb, self%l0)
+        call shift_keep(q0, q1, model%pts%x, model%pts%dx)
+        call g2p_block(model%basis, dt, v, q0, q1, model%pts%x)
+      end do
+    end do
+    !$omp end parallel do
   end subroutine drift_begin
 
-  !> x += dx, then dx = x (the start positions of a trapezoidal drift).
-  subroutine shift_keep(np, x, dx)
-    integer, intent(in) :: np                        !! number of particles
-    real(wp), intent(inout), contiguous :: x(:,:)    !! positions (ndim, >= np)
+  !> x += dx, then dx = x, for particles q0..q1 (the start positions of a trapezoidal drift).
+  pure subroutine shift_keep(q0, q1, x, dx)
+    integer, intent(in) :: q0                        !! first particle
+    integer, intent(in) :: q1                        !! last particle
+    real(wp), intent(inout), contiguous :: x(:,:)    !! positions (ndim, >= q1)
     real(wp), intent(inout), contiguous :: dx(:,:)   !! corrections in, start positions out
-    integer :: p
-    !$omp parallel do default(none) shared(np, x, dx) schedule(static) &
-    !$omp   if(np >= EMPM_OMP_MIN_PARTICLES)
-    do p = 1, np
-      x(:, p) = x(:, p) + dx(:, p)
-      dx(:, p) = x(:, p)
+    integer :: p, k
+    ! Element loops: an array assignment of ndim entries compiles to a library copy.
+    do p = q0, q1
+      do k = 1, size(x, 1)
+        x(k, p) = x(k, p) + dx(k, p)
+        dx(k, p) = x(k, p)
+      end do
     end do
-    !$omp end parallel do
   end subroutine shift_keep
 
-  !> dx = ½(dx − x): with dx the start positions, −½ of the displacement since.
-  subroutine half_back(np, x, dx)
-    integer, intent(in) :: np                        !! number of particles
-    real(wp), intent(in), contiguous :: x(:,:)       !! positions (ndim, >= np)
+  !> dx = ½(dx − x) for particles q0..q1: with dx the start positions, −½ the displacement.
+  pure subroutine half_back(q0, q1, x, dx)
+    integer, intent(in) :: q0                        !! first particle
+    integer, intent(in) :: q1                        !! last particle
+    real(wp), intent(in), contiguous :: x(:,:)       !! positions (ndim, >= q1)
     real(wp), intent(inout), contiguous :: dx(:,:)   !! start positions in, −½ displacement out
+    integer :: p, k
+    do p = q0, q1
+      do k = 1, size(x, 1)
+        dx(k, p) = 0.5_wp * (dx(k, p) - x(k, p))
+      end do
+    end do
+  end subroutine half_back
+
+  !> l0(:, :, q0:q1) = the ndim × ndim part of a block of gradients.
+  pure subroutine keep_gradients(d, q0, q1, Lb, l0)
+    integer, intent(in) :: d                          !! dimension
+    integer, intent(in) :: q0                         !! first particle of the block
+    integer, intent(in) :: q1                         !! last particle
+    real(wp), intent(in) :: Lb(:,:,:)                 !! block gradients (3, 3, >= q1-q0+1)
+    real(wp), intent(inout), contiguous :: l0(:,:,:)  !! kept gradients (d, d, >= q1)
     integer :: p
-    !$omp parallel do default(none) shared(np, x, dx) schedule(static) &
-    !$omp   if(np >= EMPM_OMP_MIN_PARTICLES)
-    do p = 1, np
-      dx(:, p) = 0.5_wp * (dx(:, p) - x(:, p))
+    select case (d)
+    case (1)
+      l0(1, 1, q0:q1) = Lb(1, 1, 1:q1 - q0 + 1)
+    case (2)
+      do p = q0, q1
+        l0(1, 1, p) = Lb(1, 1, p - q0 + 1); l0(2, 1, p) = Lb(2, 1, p - q0 + 1)
+        l0(1, 2, p) = Lb(1, 2, p - q0 + 1); l0(2, 2, p) = Lb(2, 2, p - q0 + 1)
+      end do
+    case default
+      l0(:, :, q0:q1) = Lb(:, :, 1:q1 - q0 + 1)
+    end select
+  end subroutine keep_gradients
+
+  !> dx = ½(dx − x) + c G2P(u): with dx the start positions of the drift, −½ of its
+  !> displacement plus the new basis' share (the last part of [[drift_end]]), block by block.
+  subroutine close_correction(model, u, c)
+    type(empm_model_t), intent(inout) :: model       !! simulation state
+    real(wp), intent(in), contiguous :: u(:,:)       !! u_I (ndim, nnode)
+    real(wp), intent(in) :: c                        !! ½Δt
+    integer :: np, nc, ic, a, b, q0, q1
+    np = model%pts%np
+    nc = empm_chunks(np)
+    !$omp parallel do default(none) schedule(static, 1) shared(model, u, c, np, nc) &
+    !$omp& private(a, b, q0, q1) if(nc > 1)
+    do ic = 0, nc - 1
+      call empm_chunk_bounds(np, nc, ic, a, b)
+      do q0 = a, b, STRESS_BLOCK
+        q1 = min(b, q0 + STRESS_BLOCK - 1)
+        call half_back(q0, q1, model%pts%x, model%pts%dx)
+        call g2p_block(model%basis, c, u, q0, q1, model%pts%dx)
+      end do
     end do
     !$omp end parallel do
-  end subroutine half_back
+  end subroutine close_correction
 
   !> The second half of the trapezoidal drift, after the particles moved: the basis at x^{n+1}
   !> (the step's one evaluation, carried into the next step), the particle velocities `pts%v`
@@ -552,8 +611,6 @@ contains
     type(empm_model_t), intent(inout) :: model       !! simulation state
     real(wp), intent(in) :: dt                       !! time step [s]
     type(empm_step_status_t), intent(inout) :: stat  !! set on failure
-    integer :: np
-    np = model%pts%np
     self%basis_ready = .false.
     call map_velocity(self, model, stat)
     if (stat%code /= 0) return
@@ -562,43 +619,9 @@ contains
     call self%timer%lap(PHASE_STRESS)
     if (stat%code /= 0) return
     ! dx = ½Δt (G2P(u)_p − G2P(v)_p), the second from the displacement: ½(x_start − x).
-    call half_back(np, model%pts%x, model%pts%dx)
-    call g2p_add_scaled(model%basis, 0.5_wp * dt, model%nodes%vel, model%pts%dx)
+    call close_correction(model, model%nodes%vel, 0.5_wp * dt)
     call self%timer%lap(PHASE_G2P)
   end subroutine drift_end
-
-  !> The velocity gradients L_p = Σ_I v_I ⊗ ∇N_Ip of every particle, for a scheme that combines
-  !> two of them in one stress update (only the ndim × ndim part: less memory traffic).
-  subroutine particle_gradients(model, vel, lg)
-    type(empm_model_t), intent(in) :: model          !! simulation state (basis)
-    real(wp), intent(in), contiguous :: vel(:,:)     !! nodal velocities (ndim, nnode)
-    real(wp), intent(inout), contiguous :: lg(:,:,:) !! gradients (ndim, ndim, >= np)
-    real(wp) :: Lb(3, 3, STRESS_BLOCK)
-    integer :: np, nc, c, a, b, q0, q1, d, p
-    np = model%pts%np; d = model%grid%ndim
-    nc = empm_chunks(np)
-    !$omp parallel do default(none) schedule(static, 1) shared(model, vel, lg, np, nc, d) &
-    !$omp& private(a, b, q0, q1, p, Lb) if(nc > 1)
-    do c = 0, nc - 1
-      call empm_chunk_bounds(np, nc, c, a, b)
-      do q0 = a, b, STRESS_BLOCK
-        q1 = min(b, q0 + STRESS_BLOCK - 1)
-        call velocity_gradient(model%basis, vel, q0, q1, Lb)
-        select case (d)
-        case (1)
-          lg(1, 1, q0:q1) = Lb(1, 1, 1:q1 - q0 + 1)
-        case (2)
-          do p = q0, q1
-            lg(1, 1, p) = Lb(1, 1, p - q0 + 1); lg(2, 1, p) = Lb(2, 1, p - q0 + 1)
-            lg(1, 2, p) = Lb(1, 2, p - q0 + 1); lg(2, 2, p) = Lb(2, 2, p - q0 + 1)
-          end do
-        case default
-          lg(:, :, q0:q1) = Lb(:, :, 1:q1 - q0 + 1)
-        end select
-      end do
-    end do
-    !$omp end parallel do
-  end subroutine particle_gradients
 
   !> L := ½(L⁰ + L) + ½Δt L L⁰ for a block of particles: with L⁰ the gradient of the drift's
   !> velocity field on the basis of x^n and L that of the same particle velocities on the basis

@@ -130,8 +130,7 @@ contains
         ! particles → grid → particles moves with the particles; docs/integrators.md), then
         ! the stress with the drift's deformation gradient.
         call particle_axpy(pts%np, (g - 0.5_wp) * dt * dt, pts%a, pts%x)
-        call drift_begin(self, model, nodes%vel)
-        call g2p_add_scaled(basis, dt, nodes%vel, pts%x)
+        call drift_begin(self, model, nodes%vel, dt)
         call particle_axpy(pts%np, (1.0_wp - g) * dt, pts%a, pts%v)
         call tm%lap(PHASE_G2P)
         call drift_end(self, model, dt, stat)

@@ -36,7 +36,7 @@ module empm_transfer
   private
   public :: empm_p2g_work_t
   public :: p2g_mass, p2g_weighted, p2g_mass_momentum, p2g_internal_force, p2g_body_force
-  public :: g2p_value, g2p_add_scaled, velocity_gradient
+  public :: g2p_value, g2p_add_scaled, g2p_block, velocity_gradient
   public :: nodal_divide_by_mass
 
   !> Workspace of a race-free threaded P2G: the mode, the node ranges and the per-thread
@@ -517,35 +517,50 @@ contains
     !$omp end parallel do
   end subroutine g2p_value
 
+  !> u(:, p) += c Σ_I N_Ip q_I for the particles p0..p1 only, without threads: the G2P of one
+  !> block inside a caller's own threaded loop (e.g. a block that also forms the gradients),
+  !> with the same arithmetic as [[g2p_add_scaled]].
+  pure subroutine g2p_block(basis, c, q, p0, p1, u)
+    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
+    real(wp), intent(in) :: c                        !! scale
+    real(wp), intent(in), contiguous :: q(:,:)       !! nodal vectors (ndim, nnode)
+    integer, intent(in) :: p0                        !! first particle
+    integer, intent(in) :: p1                        !! last particle
+    real(wp), intent(inout), contiguous :: u(:,:)    !! particle vectors (ndim, >= p1)
+    real(wp) :: s(3)
+    integer :: p, k, d
+    d = basis%ndim
+    if (p1 < p0) return
+    if (basis%layout == BASIS_Q4) then
+      call g2p_q4(basis%stride, p0, p1, basis%cell, basis%t, q, .true., c, u)
+      return
+    end if
+    if (d == 2) then
+      call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .true., c, u)
+      return
+    end if
+    do p = p0, p1
+      s(1:d) = 0.0_wp
+      do k = 1, basis%nn(p)
+        s(1:d) = s(1:d) + basis%N(k, p) * q(:, basis%node(k, p))
+      end do
+      u(:, p) = u(:, p) + c * s(1:d)
+    end do
+  end subroutine g2p_block
+
   !> Add a scaled interpolated nodal vector: u_p += c Σ_I N_Ip q_I.
   subroutine g2p_add_scaled(basis, c, q, u)
     type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
     real(wp), intent(in) :: c                        !! scale (e.g. Δt)
     real(wp), intent(in), contiguous :: q(:,:)       !! nodal vectors (ndim, nnode)
     real(wp), intent(inout), contiguous :: u(:,:)    !! particle vectors (ndim, np)
-    real(wp) :: s(3)
-    integer :: ic, nc, p0, p1, p, k, d
-    d = basis%ndim
+    integer :: ic, nc, p0, p1
     nc = empm_chunks(basis%np)
     !$omp parallel do num_threads(nc) schedule(static, 1) default(none) &
-    !$omp   shared(basis, c, q, u, nc, d) private(p0, p1, p, k, s) if(nc > 1)
+    !$omp   shared(basis, c, q, u, nc) private(p0, p1) if(nc > 1)
     do ic = 0, nc - 1
       call empm_chunk_bounds(basis%np, nc, ic, p0, p1)
-      if (basis%layout == BASIS_Q4) then
-        call g2p_q4(basis%stride, p0, p1, basis%cell, basis%t, q, .true., c, u)
-        cycle
-      end if
-      if (d == 2) then
-        call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .true., c, u)
-        cycle
-      end if
-      do p = p0, p1
-        s(1:d) = 0.0_wp
-        do k = 1, basis%nn(p)
-          s(1:d) = s(1:d) + basis%N(k, p) * q(:, basis%node(k, p))
-        end do
-        u(:, p) = u(:, p) + c * s(1:d)
-      end do
+      call g2p_block(basis, c, q, p0, p1, u)
     end do
     !$omp end parallel do
   end subroutine g2p_add_scaled
