@@ -465,10 +465,12 @@ contains
     type(empm_step_status_t), intent(inout) :: stat !! set on failure
     class(empm_integrator_t), intent(inout), optional :: integ !! the scheme (smoothing option
                                                     !! and its scratch)
-    real(wp), intent(in), contiguous, optional :: lprev(:,:,:) !! with it, the particles' L at
-                                                    !! the start of the step (3, 3, np): the
+    real(wp), intent(in), contiguous, optional :: lprev(:,:,:) !! with it (a trapezoidal drift,
+                                                    !! [[drift_end]]), the particles' L at the
+                                                    !! start of the step (ndim, ndim, np): the
                                                     !! material gets the trapezoidal gradient
-                                                    !! of [[trapezoid_gradient]]
+                                                    !! of [[trapezoid_gradient]], and the drift's
+                                                    !! correction `pts%dx` is formed
     real(wp) :: none1(0), none2(0, 0), none3(0, 0, 0)
     logical :: sm, tz
     sm = .false.
@@ -578,28 +580,6 @@ contains
     end select
   end subroutine keep_gradients
 
-  !> dx = ½(dx − x) + c G2P(u): with dx the start positions of the drift, −½ of its
-  !> displacement plus the new basis' share (the last part of [[drift_end]]), block by block.
-  subroutine close_correction(model, u, c)
-    type(empm_model_t), intent(inout) :: model       !! simulation state
-    real(wp), intent(in), contiguous :: u(:,:)       !! u_I (ndim, nnode)
-    real(wp), intent(in) :: c                        !! ½Δt
-    integer :: np, nc, ic, a, b, q0, q1
-    np = model%pts%np
-    nc = empm_chunks(np)
-    !$omp parallel do default(none) schedule(static, 1) shared(model, u, c, np, nc) &
-    !$omp& private(a, b, q0, q1) if(nc > 1)
-    do ic = 0, nc - 1
-      call empm_chunk_bounds(np, nc, ic, a, b)
-      do q0 = a, b, STRESS_BLOCK
-        q1 = min(b, q0 + STRESS_BLOCK - 1)
-        call half_back(q0, q1, model%pts%x, model%pts%dx)
-        call g2p_block(model%basis, c, u, q0, q1, model%pts%dx)
-      end do
-    end do
-    !$omp end parallel do
-  end subroutine close_correction
-
   !> The second half of the trapezoidal drift, after the particles moved: the basis at x^{n+1}
   !> (the step's one evaluation, carried into the next step), the particle velocities `pts%v`
   !> mapped on it (u_I in `nodes%vel`), the stress with the trapezoidal gradient of L⁰ and
@@ -615,12 +595,10 @@ contains
     call map_velocity(self, model, stat)
     if (stat%code /= 0) return
     self%basis_ready = .true.
+    ! The stress blocks also form dx = ½Δt (G2P(u)_p − G2P(v)_p), the second term from the
+    ! displacement, ½(x_start − x).
     call update_stress(model, model%nodes%vel, dt, stat, self, self%l0)
     call self%timer%lap(PHASE_STRESS)
-    if (stat%code /= 0) return
-    ! dx = ½Δt (G2P(u)_p − G2P(v)_p), the second from the displacement: ½(x_start − x).
-    call close_correction(model, model%nodes%vel, 0.5_wp * dt)
-    call self%timer%lap(PHASE_G2P)
   end subroutine drift_end
 
   !> L := ½(L⁰ + L) + ½Δt L L⁰ for a block of particles: with L⁰ the gradient of the drift's
@@ -717,7 +695,8 @@ contains
   end subroutine smooth_volumetric
 
   !> The block loop of [[update_stress]]; with `tz`, L_p is first combined with `lprev`
-  !> ([[trapezoid_gradient]]); with `sm`, its volumetric part is then replaced by
+  !> ([[trapezoid_gradient]]) and the block's drift correction `pts%dx` formed
+  !> ([[drift_end]]); with `sm`, its volumetric part is then replaced by
   !> ē_p = `bar(1, p)` (`tr(p)` = tr L_p) before the material call.
   subroutine stress_blocks(model, vel, dt, stat, sm, tr, bar, tz, lprev)
     type(empm_model_t), intent(inout) :: model
@@ -750,7 +729,13 @@ contains
         do q0 = a, b, STRESS_BLOCK
           q1 = min(b, q0 + STRESS_BLOCK - 1)
           call velocity_gradient(model%basis, vel, q0, q1, Lb)
-          if (tz) call trapezoid_gradient(dt, lprev(:, :, q0:q1), Lb)
+          if (tz) then
+            ! The trapezoidal drift: its gradient, and its position correction while the
+            ! block's basis is in cache, dx = ½(dx − x) + ½Δt G2P(u) ([[drift_end]]).
+            call trapezoid_gradient(dt, lprev(:, :, q0:q1), Lb)
+            call half_back(q0, q1, model%pts%x, model%pts%dx)
+            call g2p_block(model%basis, 0.5_wp * dt, vel, q0, q1, model%pts%dx)
+          end if
           if (sm) then
             do p = q0, q1
               dv = (bar(1, p) - tr(p)) / ctx%ndim
