@@ -8,23 +8,38 @@
 !> 3. Δu_I = Δt v_I + Δt² ((½ − β) a_I + β a⁺_I)
 !> 4. x_p += Σ N Δu_I;  v_p += Δt Σ N ((1−γ) a_I + γ a⁺_I);  a_p = Σ N a⁺_I
 !> 5. L_p = Σ (Δu_I/Δt) ⊗ ∇N: the strain increment matches the displacement of step 4.
+!>
+!> `gen_alpha_p` (the same α_m, β, γ), second order under large motion
+!> (docs/integrators.md): the α_m recursion runs on the particles,
+!> a_p⁺ = (Σ N f_I/m_I − α_m a_p)/(1 − α_m); the Newmark displacement is formed on the particles
+!> and projected, Δu_I = Δt P2G(v + Δt((½ − β) a + β a⁺))_I (as pc_newmark projects v*), with
+!> the trapezoidal drift over the bases of x^n and x^{n+1} and its deformation gradient;
+!> v_p += Δt((1 − γ) a_p + γ a_p⁺), a_p = a_p⁺.
 module empm_integrator_genalpha
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t
   use empm_params, only: empm_param_t, empm_param, PARAM_REAL
   use empm_namelist, only: empm_group_t
-  use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration
+  use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration, &
+                             drift_prepare, drift_begin, drift_end
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: p2g_weighted, g2p_add_scaled, g2p_value, &
                            nodal_divide_by_mass
   use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
   implicit none
   private
-  public :: empm_genalpha_t, genalpha_parameters
+  public :: empm_genalpha_t, genalpha_parameters, GA_PUBLISHED, GA_PARTICLE
+
+  integer, parameter :: GA_PUBLISHED = 1 !! Tran & Sołowski's scheme (nodal α_m recursion)
+  integer, parameter :: GA_PARTICLE = 2  !! α_m recursion and Newmark displacement on the
+                                         !! particles, trapezoidal drift
 
   !> Explicit generalized-α.
   type, extends(empm_integrator_t) :: empm_genalpha_t
     real(wp) :: rho_b = 0.8_wp  !! spectral radius at infinite frequency, in [0, 1]
+    integer :: variant = GA_PUBLISHED !! GA_PUBLISHED or GA_PARTICLE
+    real(wp), allocatable :: dv(:,:) !! gen_alpha_particle: the new particle accelerations of a
+                                     !! step (ndim, np)
   contains
     procedure :: step => ga_step
     procedure :: family => ga_family
@@ -47,20 +62,27 @@ contains
     gamma = 1.5_wp - alpha_m
   end subroutine genalpha_parameters
 
-  !> Registry name "gen_alpha".
+  !> Registry name: "gen_alpha" or "gen_alpha_p".
   pure function ga_family(self) result(s)
     class(empm_genalpha_t), intent(in) :: self !! integrator
     character(len=:), allocatable :: s        !! name
-    associate (unused_ => self); end associate
-    s = 'gen_alpha'
+    if (self%variant == GA_PARTICLE) then
+      s = 'gen_alpha_p'
+    else
+      s = 'gen_alpha'
+    end if
   end function ga_family
 
   !> One-line description.
   pure function ga_summary(self) result(s)
     class(empm_genalpha_t), intent(in) :: self !! integrator
     character(len=:), allocatable :: s        !! summary
-    associate (unused_ => self); end associate
-    s = 'explicit generalized-alpha (Tran & Solowski 2019)'
+    if (self%variant == GA_PARTICLE) then
+      s = 'explicit generalized-alpha with the recursion and displacement on the particles '// &
+          'and a trapezoidal drift'
+    else
+      s = 'explicit generalized-alpha (Tran & Solowski 2019)'
+    end if
   end function ga_summary
 
   !> Parameters: the spectral radius at infinite frequency ρ_b.
@@ -86,6 +108,11 @@ contains
   subroutine ga_start(self, model)
     class(empm_genalpha_t), intent(inout) :: self !! integrator
     type(empm_model_t), intent(inout) :: model    !! simulation state
+    if (self%variant == GA_PARTICLE) then
+      call drift_prepare(self, model)
+      if (allocated(self%dv)) deallocate(self%dv)
+      allocate(self%dv(model%grid%ndim, model%pts%np))
+    end if
     call initial_acceleration(self, model)
   end subroutine ga_start
 
@@ -97,6 +124,10 @@ contains
     type(empm_step_status_t), intent(out) :: stat   !! outcome
     real(wp) :: am, be, ga
     call genalpha_parameters(self%rho_b, am, be, ga)
+    if (self%variant == GA_PARTICLE) then
+      call particle_step(self, model, dt, am, be, ga, stat)
+      return
+    end if
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
       call map_velocity(self, model, stat)
       if (stat%code /= STEP_OK) return
@@ -127,4 +158,46 @@ contains
       call tm%lap(PHASE_STRESS)
     end associate
   end subroutine ga_step
+
+  !> One `gen_alpha_p` step (module header). The first mapping gives the masses, the
+  !> step's velocities for the local damping and the carried basis' reuse; the second maps
+  !> the displacement rate w_p = v_p + Δt((½ − β) a_p + β a_p⁺) on the same basis.
+  subroutine particle_step(self, model, dt, am, be, ga, stat)
+    class(empm_genalpha_t), intent(inout) :: self   !! integrator
+    type(empm_model_t), intent(inout) :: model      !! simulation state
+    real(wp), intent(in) :: dt                      !! time step [s]
+    real(wp), intent(in) :: am                      !! α_m
+    real(wp), intent(in) :: be                      !! β
+    real(wp), intent(in) :: ga                      !! γ
+    type(empm_step_status_t), intent(out) :: stat   !! outcome
+    integer :: np
+    associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
+      np = pts%np
+      call map_velocity(self, model, stat)
+      if (stat%code /= STEP_OK) return
+      self%basis_ready = .true. ! the masses stay valid: the next mapping adds only momentum
+      call self%assemble_forces(model, model%t)
+      call tm%lap(PHASE_P2G)
+      call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
+      call nodes%constrain_force(nodes%acc)
+      call tm%lap(PHASE_GRID)
+      ! a_p⁺ in dv; then v_p holds w_p while the drift maps it.
+      call g2p_value(basis, nodes%acc, self%dv)
+      self%dv(:, 1:np) = (self%dv(:, 1:np) - am * pts%a(:, 1:np)) / (1.0_wp - am)
+      pts%v(:, 1:np) = pts%v(:, 1:np) + dt * ((0.5_wp - be) * pts%a(:, 1:np) + &
+                                              be * self%dv(:, 1:np))
+      call tm%lap(PHASE_G2P)
+      call map_velocity(self, model, stat)
+      if (stat%code /= STEP_OK) return
+      call drift_begin(self, model, nodes%vel, dt)
+      call tm%lap(PHASE_G2P)
+      call drift_end(self, model, dt, stat)
+      if (stat%code /= STEP_OK) return
+      ! v_p = w_p + Δt((½ − γ + β) a_p + (γ − β) a_p⁺) = v_p^n + Δt((1 − γ) a_p + γ a_p⁺).
+      pts%v(:, 1:np) = pts%v(:, 1:np) + dt * ((0.5_wp - ga + be) * pts%a(:, 1:np) + &
+                                              (ga - be) * self%dv(:, 1:np))
+      pts%a(:, 1:np) = self%dv(:, 1:np)
+      call tm%lap(PHASE_G2P)
+    end associate
+  end subroutine particle_step
 end module empm_integrator_genalpha

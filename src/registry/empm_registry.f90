@@ -35,7 +35,7 @@ module empm_registry
   use empm_integrator, only: empm_integrator_t
   use empm_integrator_euler, only: empm_euler_t, EULER_USF, EULER_USL, EULER_MUSL
   use empm_integrator_pc, only: empm_pc_t, PC_PUBLISHED, PC_NEWMARK
-  use empm_integrator_genalpha, only: empm_genalpha_t
+  use empm_integrator_genalpha, only: empm_genalpha_t, GA_PUBLISHED, GA_PARTICLE
   implicit none
   private
   public :: empm_registry_t, empm_default_registry
@@ -92,7 +92,8 @@ contains
     call reg%add_integrator(empm_euler_t(variant=EULER_MUSL))
     call reg%add_integrator(empm_pc_t(variant=PC_PUBLISHED))
     call reg%add_integrator(empm_pc_t(variant=PC_NEWMARK))
-    call reg%add_integrator(empm_genalpha_t())
+    call reg%add_integrator(empm_genalpha_t(variant=GA_PUBLISHED))
+    call reg%add_integrator(empm_genalpha_t(variant=GA_PARTICLE))
   end function empm_default_registry
 
   ! ---- convenience, for programs that build a model without a case file ------------------

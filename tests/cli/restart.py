@@ -37,7 +37,7 @@ import time
 import h5py
 import numpy as np
 
-SCHEMES = ["usf", "usl", "musl", "pc_published", "pc_newmark", "gen_alpha"]
+SCHEMES = ["usf", "usl", "musl", "pc_published", "pc_newmark", "gen_alpha", "gen_alpha_p"]
 SHAPES = ["linear", "ugimp", "bspline2", "lme_g3"]
 
 CASE_2D = """&grid ndim = 2, origin = -0.5, -0.5, h = 0.25, cells = {cells}, {cells} /
