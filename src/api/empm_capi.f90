@@ -518,12 +518,10 @@ contains
       case ('density'); pts%rho(1:np) = buf(1:n)
       case default; pts%state(row, 1:np) = buf(1:n)
       end select
-      ! New positions or masses invalidate a basis (and its nodal masses) carried from the last
-      ! step, and a pending drift correction belongs to the old positions.
-      if (field == 'x' .or. field == 'mass') then
-        if (field == 'x') pts%dx(:, 1:np) = 0.0_wp
-        if (allocated(b%integ)) call b%integ%resync(b%model)
-      end if
+      ! A pending pc_newmark drift correction belongs to the old positions. (Each step goes
+      ! through empm_solve, which prepares the integrator afresh: no basis is carried across
+      ! the calls.)
+      if (field == 'x') pts%dx(:, 1:np) = 0.0_wp
     end associate
   end function capi_set_field
 
