@@ -184,7 +184,7 @@ contains
     if (stat%code /= 0) return
     call model%nodes%reset()
     call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
-    call extend_masses(self, model, .true.)
+    call extend_masses(self, model)
     model%nodes%vel = 0.0_wp ! no damping in this assembly
     call self%assemble_forces(model, model%t)
   end subroutine monitor_initial
@@ -208,7 +208,7 @@ contains
     if (stat%code /= 0) return
     call model%nodes%reset()
     call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
-    call extend_masses(self, model, .true.)
+    call extend_masses(self, model)
     call self%assemble_forces(model, model%t)
     call nodal_divide_by_mass(model%nodes, model%nodes%force, model%nodes%acc)
     call g2p_value(model%basis, model%nodes%acc, model%pts%a)
@@ -244,22 +244,19 @@ contains
     end if
   end subroutine eval_basis
 
-  !> After the nodal masses were accumulated: mirror ghosts' masses go to their images; with the
-  !> extension of nearly-empty nodes on ([[empm_extension]]), find them when the basis is new
-  !> (`fresh`; their filled volumes in one more P2G) and gather the masses, m̂ = Eᵀm. Without
-  !> mirrors and degenerate nodes nothing changes.
-  subroutine extend_masses(self, model, fresh)
+  !> After the nodal masses were accumulated on a new basis: mirror ghosts' masses go to their
+  !> images; with the extension of nearly-empty nodes on ([[empm_extension]]), find them (their
+  !> filled volumes in one more P2G) and gather the masses, m̂ = Eᵀm. Without mirrors and
+  !> degenerate nodes nothing changes. (A carried basis keeps its masses: [[map_velocity]].)
+  subroutine extend_masses(self, model)
     class(empm_integrator_t), intent(inout) :: self   !! integrator (P2G workspace)
     type(empm_model_t), intent(inout) :: model        !! simulation state
-    logical, intent(in) :: fresh                      !! the basis was just evaluated
     associate (nodes => model%nodes)
       if (nodes%nmirror > 0) call nodes%mirror_gather_mass()
       if (nodes%ext%theta <= 0.0_wp) return
-      if (fresh) then
-        nodes%vol = 0.0_wp
-        call p2g_mass(model%basis, model%pts%vol, nodes%vol, self%p2g)
-        call nodes%find_degenerate(model%grid)
-      end if
+      nodes%vol = 0.0_wp
+      call p2g_mass(model%basis, model%pts%vol, nodes%vol, self%p2g)
+      call nodes%find_degenerate(model%grid)
       if (nodes%ext%n > 0) call nodes%ext%gather_mass(nodes%mass)
     end associate
   end subroutine extend_masses
@@ -304,10 +301,8 @@ contains
     type(empm_step_status_t), intent(inout) :: stat   !! set on failure
     real(wp), intent(in), optional :: c               !! scale of `w`
     real(wp), intent(in), contiguous, optional :: w(:,:) !! second particle vectors (ndim, np)
-    logical :: fresh
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
       call tm%mark()
-      fresh = .not. self%basis_ready
       if (self%basis_ready) then
         ! The carried basis came with its nodal masses (extended and gathered): only the
         ! momentum is new.
@@ -330,7 +325,7 @@ contains
           call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
                                  self%p2g)
         end if
-        call extend_masses(self, model, fresh)
+        call extend_masses(self, model)
       end if
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
