@@ -125,6 +125,7 @@ program empm_main
       case ('--integrator'); bcfg%integrator = arg(i + 1)
       case ('--material');   bcfg%material = arg(i + 1)
       case ('--material-keys'); bcfg%material_keys = arg(i + 1)
+      case ('--case');       bcfg%case_file = arg(i + 1)
       case ('--confinement')
         numtext = arg(i + 1)
         read(numtext, *, iostat=ios) bcfg%confinement
@@ -233,6 +234,7 @@ contains
     write(u, '(a)') '                  [--threads T] [--integrator I] [--warmup W]'
     write(u, '(a)') '                  [--material M] [--material-keys ''k = v, ...'']'
     write(u, '(a)') '                  [--confinement P0] [--min-fill F]'
+    write(u, '(a)') '       empm bench --case FILE [--steps K] [--warmup W] [--threads T]'
     write(u, '(a)') ''
     write(u, '(a)') 'Times a freely vibrating block (N^dim cells, P particles per cell) and'
     write(u, '(a)') 'prints one JSON object (docs/performance.md). S is a shape identifier as in a'
@@ -250,6 +252,11 @@ contains
     write(u, '(a)') 'relative to the working folder. F is the fill below which nodes are extended'
     write(u, '(a)') '(&grid min_fill; default 0.1, 0: off). "plastic_fraction" in the output is the'
     write(u, '(a)') 'share of particle updates that changed a state variable.'
+    write(u, '(a)') ''
+    write(u, '(a)') 'With --case, the model, integrator and time step of a case file are timed'
+    write(u, '(a)') 'instead of the block (its dt, or cfl times the stable step at the start):'
+    write(u, '(a)') 'the integrator''s steps alone, without the guards, histories, snapshots and'
+    write(u, '(a)') 'output of `empm run FILE`, whose time-loop wall time it can be compared with.'
   end subroutine usage_bench
 
   subroutine usage_keys(u)

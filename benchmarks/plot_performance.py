@@ -164,6 +164,7 @@ def main():
         md.append(f'| {r["shape"]} | {r["threads"]} | {fmt(r["particle_steps_per_second"])} |')
     md.append("")
     md += materials_section(Path(sys.argv[1]).with_name("materials.jsonl"), rev)
+    md += run_path_section(Path(sys.argv[1]).with_name("runpath.jsonl"))
     (out / "performance.md").write_text("\n".join(md))
     print(f"wrote {out / 'performance.md'} and {out / 'performance.png'}")
 
@@ -207,6 +208,43 @@ def materials_section(path, rev):
         md.append(f"| {m} | {fmt(med)} | {1e9 / med:.0f} | {ref if m != ref else ''} | "
                   f"{rmed:.2f}×{rng} | {tgt} | {met} |" if m != ref else
                   f"| {m} | {fmt(med)} | {1e9 / med:.0f} | | 1 | | |")
+    md.append("")
+    return md
+
+
+def run_path_section(path):
+    """`empm run` against `empm bench --case` on the same case file (issue 17, item 1): per
+    round the ratio of the time loop's wall time to the bench's, their median and range."""
+    if not path.exists():
+        return []
+    rows = {}
+    with open(path) as f:
+        for line in f:
+            d = json.loads(line)
+            key = (d["dim"], d["shape"])
+            rows.setdefault(key, []).append(d)
+    md = ["## `empm run` against `empm bench` (issue 17, item 1)", "",
+          "`benchmarks/run --run-path`: the bench's block as a case file "
+          "(`benchmarks/block_case.py`: 2D 128² cells, 3D 20³ cells, 2 Gauss particles per "
+          "direction and cell, linear elastic, pc_newmark at Courant number 0.5), run by "
+          "`empm run` with the defaults of a case file (guards, last good state, energies "
+          "sampled every step, progress lines), against the same file's model timed by "
+          "`empm bench --case` for the same number of steps (the integrator's steps alone); "
+          "1 thread, interleaved rounds. `run`: the time loop's wall time that `empm run` "
+          "prints. Ratio: run / bench of each round, median (range).", "",
+          "| dim | shape | particles | steps | run particle-steps/s | bench particle-steps/s | "
+          "ratio | target | met |", "|---|---|---|---|---|---|---|---|---|"]
+    for (dim, shape), ds in sorted(rows.items()):
+        np_ = ds[0]["bench"]["particles"]
+        steps = ds[0]["steps"]
+        runs = [np_ * d["steps"] / d["run_seconds"] for d in ds]
+        benches = [d["bench"]["particle_steps_per_second"] for d in ds]
+        ratios = [d["run_seconds"] / d["bench"]["seconds"] for d in ds]
+        rmed = float(statistics.median(ratios))
+        md.append(f"| {dim} | {shape} | {np_} | {steps} | {fmt(statistics.median(runs))} | "
+                  f"{fmt(statistics.median(benches))} | {rmed:.3f} "
+                  f"({min(ratios):.3f}–{max(ratios):.3f}) | ≤ 1.10 | "
+                  f"{'yes' if rmed <= 1.10 else '**no**'} |")
     md.append("")
     return md
 

@@ -35,6 +35,8 @@ module empm_bench
   use empm_parallel, only: empm_set_threads, empm_max_threads
   use empm_strings, only: str, lower
   use empm_files, only: empm_proc_kib
+  use empm_case, only: empm_case_t
+  use empm_input, only: empm_read_case
   implicit none
   private
   public :: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json, &
@@ -60,6 +62,10 @@ module empm_bench
     real(wp) :: confinement = -1.0_wp                !! initial isotropic compression p0 [Pa]
                                                      !! (< 0: the model's bench default)
     real(wp) :: min_fill = -1.0_wp                   !! `&grid min_fill` (< 0: the default)
+    character(len=1024) :: case_file = ''            !! time this case file's model instead of
+                                                     !! the block ('': the block); the other
+                                                     !! fields but steps, warmup and threads
+                                                     !! are then unused
   end type empm_bench_config_t
 
   !> What was measured (the JSON of `empm bench`, plus a checksum for tests).
@@ -86,24 +92,26 @@ module empm_bench
 
 contains
 
-  !> Build the block, warm up, time `cfg%steps` steps. `err%code` is EMPM_ERR_USAGE for a bad
-  !> configuration and EMPM_ERR_RUNTIME when a step fails.
+  !> Build the block (or read `cfg%case_file`), warm up, time `cfg%steps` steps. `err%code` is
+  !> EMPM_ERR_USAGE for a bad configuration (a case file's own input error code for a bad case)
+  !> and EMPM_ERR_RUNTIME when a step fails.
   subroutine empm_bench_run(cfg, res, err)
     type(empm_bench_config_t), intent(in) :: cfg     !! configuration
     type(empm_bench_result_t), intent(out) :: res    !! measurements
     type(empm_error_t), intent(out), optional :: err !! error, if present
     type(empm_model_t) :: model
     class(empm_integrator_t), allocatable :: integ
-    type(empm_step_status_t) :: stat
     type(empm_error_t) :: e
     real(wp) :: zero3(3), hi(3), origin(3), h(3), dt, s, p0, lo3(3), hi3(3)
     logical :: fixk(3)
     integer :: nfix
     integer :: nper, pad, nd, info, nadd, p, d, k, ncell(3)
-    integer(int64) :: rss0, rss1, c0, c1, rate, ticks, nchanged
-    real(wp), allocatable :: state0(:,:)
+    integer(int64) :: rss0
     character(len=:), allocatable :: mkeys
 
+    if (len_trim(cfg%case_file) > 0) then
+      call bench_case(cfg, res, err); return
+    end if
     nd = cfg%dim
     if (nd < 2 .or. nd > 3) then
       call empm_raise(EMPM_ERR_USAGE, 'bench: --dim must be 2 or 3', err); return
@@ -186,13 +194,35 @@ contains
     if (cfg%min_fill >= 0.0_wp) model%nodes%ext%theta = cfg%min_fill
     call integ%prepare(model)
     dt = 0.5_wp * empm_stable_dt(model)
+    call time_steps(model, integ, dt, cfg, rss0, res, err)
+    if (allocated(res%shape)) then
+      res%material = trim(cfg%material)
+      res%material_keys = mkeys
+      res%confinement = p0
+    end if
+  end subroutine empm_bench_run
+
+  !> Warm up, then time `cfg%steps` steps of `integ` on `model` (prepared) with the fixed time
+  !> step `dt`, each step alone (the state comparison for the plastic fraction stays outside the
+  !> timing), and fill `res`: `res%shape` stays unallocated when a step failed (`err` set).
+  subroutine time_steps(model, integ, dt, cfg, rss0, res, err)
+    type(empm_model_t), intent(inout) :: model           !! set-up model
+    class(empm_integrator_t), intent(inout) :: integ     !! prepared integrator
+    real(wp), intent(in) :: dt                           !! time step [s]
+    type(empm_bench_config_t), intent(in) :: cfg         !! steps and warm-up steps
+    integer(int64), intent(in) :: rss0                   !! peak RSS before the set-up [B]
+    type(empm_bench_result_t), intent(inout) :: res      !! measurements
+    type(empm_error_t), intent(inout), optional :: err   !! a failed step
+    type(empm_step_status_t) :: stat
+    integer(int64) :: rss1, c0, c1, rate, ticks, nchanged
+    real(wp), allocatable :: state0(:,:)
+    integer :: k
 
     do k = 1, cfg%warmup
       call advance()
       if (stat%code /= STEP_OK) return
     end do
     call integ%timer%reset()
-    ! Each step timed alone, so that the state comparison stays outside the timing.
     ticks = 0; nchanged = 0
     if (model%pts%nstate > 0) allocate(state0(model%pts%nstate, model%pts%np))
     do k = 1, cfg%steps
@@ -207,16 +237,13 @@ contains
     end do
     rss1 = empm_peak_rss_bytes()
 
-    res%dim = nd
+    res%dim = model%grid%ndim
     res%shape = model%shape%name()
     res%integrator = integ%name()
     res%particles = model%pts%np
     res%nodes = model%grid%nnode
     res%steps = cfg%steps
     res%threads = empm_max_threads()
-    res%material = trim(cfg%material)
-    res%material_keys = mkeys
-    res%confinement = p0
     res%plastic_fraction = real(nchanged, wp) / (real(model%pts%np, wp) * cfg%steps)
     res%seconds = real(ticks, wp) / real(rate, wp)
     res%particle_steps_per_second = real(res%particles, wp) * cfg%steps / max(res%seconds, 1.0e-9_wp)
@@ -248,7 +275,34 @@ contains
       model%t = model%t + dt
       model%step = model%step + 1
     end subroutine advance
-  end subroutine empm_bench_run
+  end subroutine time_steps
+
+  !> `empm bench --case FILE`: the case's model, integrator and time step (its `dt`, or `cfl`
+  !> times the stable step at the start), timed as the block is: the integrator's steps alone,
+  !> without the guards, the history, the snapshots and the output of `empm run FILE`.
+  subroutine bench_case(cfg, res, err)
+    type(empm_bench_config_t), intent(in) :: cfg     !! configuration (case_file set)
+    type(empm_bench_result_t), intent(out) :: res    !! measurements
+    type(empm_error_t), intent(out), optional :: err !! error, if present
+    type(empm_case_t) :: cs
+    type(empm_error_t) :: e
+    integer(int64) :: rss0
+    real(wp) :: dt
+    call empm_set_threads(cfg%threads)
+    rss0 = empm_peak_rss_bytes()
+    call empm_read_case(trim(cfg%case_file), cs, e)
+    if (e%code == 0) call cs%integ%prepare(cs%model, e)
+    if (e%code /= 0) then
+      call empm_raise(e%code, 'bench: --case: '//e%message, err); return
+    end if
+    dt = cs%run%dt
+    if (dt <= 0.0_wp) dt = cs%run%cfl * empm_stable_dt(cs%model)
+    call time_steps(cs%model, cs%integ, dt, cfg, rss0, res, err)
+    if (.not. allocated(res%shape)) return
+    res%material = cs%model%mats(1)%model%family()
+    res%material_keys = ''
+    res%confinement = 0.0_wp
+  end subroutine bench_case
 
   !> The bench's default initial isotropic compression p0 of `name` [Pa]: camclay 1e4 Pa (its
   !> elastic stiffness K = v p'/κ vanishes with p'; with OCR = 1 the block starts on the yield

@@ -29,6 +29,10 @@ module empm_integrator
   !> Particles per material call in [[update_stress]]: their L, F, strain and stress fit in
   !> the L1 cache together.
   integer, parameter :: STRESS_BLOCK = 32
+  !> Particles per screen of the updated fields and per stored-energy call in [[update_stress]]
+  !> (the run-time guards' and the energy history's share of the stress pass): a multiple of
+  !> STRESS_BLOCK, small enough for the group's stress, strain and state to stay in cache.
+  integer, parameter :: SCREEN_GROUP = 256
 
   !> Abstract explicit integrator. Work arrays are allocated once in `prepare`. A scheme names
   !> itself (`family`, the registry name, also returned by `name`), may declare parameters
@@ -701,11 +705,19 @@ contains
     logical, intent(in) :: sm, tz
     real(wp), intent(in) :: tr(:), bar(:,:)
     real(wp), intent(in), contiguous :: lprev(:,:,:)
-    real(wp) :: Lb(3, 3, STRESS_BLOCK), dv
-    integer :: r, i0, i1, info, im, n, nc, c, a, b, q0, q1, bad, p, k
+    real(wp) :: Lb(3, 3, STRESS_BLOCK), dv, cm
+    integer :: r, i0, i1, info, im, n, nc, c, a, b, q0, q1, bad, p, k, g0
+    logical :: fine, we, ok
     type(empm_material_ctx_t) :: ctx
     ctx%t = model%t; ctx%step = model%step + 1; ctx%ndim = model%grid%ndim
     ctx%h = minval(model%grid%h(1:model%grid%ndim))
+    ! Each group of updated particles is screened for the run-time guards, gives its largest
+    ! wave speed and, when the time loop asks for it, its stored energy densities, in cache.
+    fine = .true.; cm = 0.0_wp
+    we = model%want_energy
+    if (we) we = allocated(model%diag_psi)
+    if (we) we = size(model%diag_psi) >= model%pts%np
+    model%diag_step = -1
     do r = 1, size(model%run_first)
       i0 = model%run_first(r); i1 = model%run_last(r)
       im = model%pts%mat(i0)
@@ -714,13 +726,14 @@ contains
       ! The first failing particle of the run, whichever block it is in.
       bad = huge(1)
       !$omp parallel do default(none) schedule(static, 1) &
-      !$omp& shared(model, vel, dt, i0, im, n, nc, sm, tr, bar, tz, lprev) &
-      !$omp& private(a, b, q0, q1, p, k, dv, Lb, info) firstprivate(ctx) reduction(min: bad) &
-      !$omp& if(nc > 1)
+      !$omp& shared(model, vel, dt, i0, im, n, nc, sm, tr, bar, tz, lprev, we) &
+      !$omp& private(a, b, q0, q1, p, k, dv, Lb, info, ok, g0) firstprivate(ctx) &
+      !$omp& reduction(min: bad) reduction(.and.: fine) reduction(max: cm) if(nc > 1)
       do c = 0, nc - 1
         call empm_chunk_bounds(n, nc, c, a, b)
         a = a + i0 - 1; b = b + i0 - 1
         Lb = 0.0_wp ! the blocks write only the ndim×ndim part
+        g0 = a
         do q0 = a, b, STRESS_BLOCK
           q1 = min(b, q0 + STRESS_BLOCK - 1)
           call velocity_gradient(model%basis, vel, q0, q1, Lb)
@@ -747,6 +760,19 @@ contains
           do p = q0, q1
             model%pts%vol(p) = model%pts%m(p) / model%pts%rho(p)
           end do
+          ! Every SCREEN_GROUP particles (still in cache), one screen and one energy call:
+          ! per 32-particle block their calls cost more than their arithmetic.
+          if (q1 - g0 + 1 >= SCREEN_GROUP .or. q1 == b) then
+            ok = model%pts%material_fields_fine(g0, q1)
+            fine = fine .and. ok
+            ! The next step's CFL limit (only on fine values: a NaN would trap in a debug build).
+            if (ok) cm = max(cm, model%mats(im)%model%max_wave_speed(model%pts%rho(g0:q1), &
+              model%pts%stress(:, g0:q1), model%pts%state(:, g0:q1)))
+            if (we .and. ok) call model%mats(im)%model%energy_density(model%pts%F(:, :, g0:q1), &
+              model%pts%strain(:, g0:q1), model%pts%stress(:, g0:q1), &
+              model%pts%state(:, g0:q1), model%diag_psi(g0:q1))
+            g0 = q1 + 1
+          end if
         end do
       end do
       !$omp end parallel do
@@ -755,5 +781,7 @@ contains
         return
       end if
     end do
+    model%diag_step = ctx%step; model%diag_fine = fine; model%diag_cmax = cm
   end subroutine stress_blocks
+
 end module empm_integrator

@@ -145,9 +145,11 @@ contains
   end subroutine material_init_state
 
   !> Largest P-wave speed over a run of particles of this material, for the CFL time step
-  !> (evaluated every step). The default is `wave_speed` at the smallest density (wave speeds
-  !> do not increase with density); a model whose stiffness depends on the stress or the
-  !> state (pressure-dependent elasticity) overrides it.
+  !> (evaluated every step). It must be a maximum over the particles: the stress update asks
+  !> it of groups of particles while they are in cache and the time loop takes the largest.
+  !> The default is `wave_speed` at the smallest density (wave speeds do not increase with
+  !> density); a model whose stiffness depends on the stress or the state (pressure-dependent
+  !> elasticity) overrides it.
   pure real(wp) function material_max_wave_speed(self, rho, stress, state) result(c)
     class(empm_material_t), intent(in) :: self !! material
     real(wp), intent(in) :: rho(:)             !! densities of the run (n) [kg/m³]

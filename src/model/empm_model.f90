@@ -51,6 +51,21 @@ module empm_model
     real(wp) :: residual = -1.0_wp                      !! from the last assembly (with
                                                         !! `track`): ‖f_unbalanced‖/‖f_ext‖,
                                                         !! −1 when unknown or no load acts
+    ! What a stress update computes while each block is in cache, for the time loop:
+    logical :: want_energy = .false.                    !! set before a step: the stress update
+                                                        !! also evaluates the stored energy
+                                                        !! densities (into diag_psi)
+    integer :: diag_step = -1                           !! the step whose stress update computed
+                                                        !! the two below (−1: none)
+    logical :: diag_fine = .true.                       !! its screen of the material fields
+                                                        !! (stress, strain, state finite;
+                                                        !! density, volume finite and > 0)
+    real(wp), allocatable :: diag_psi(:)                !! with want_energy, the stored energy
+                                                        !! density ψ of each particle after it
+                                                        !! (np) [J/m³]; allocated by the
+                                                        !! time loop
+    real(wp) :: diag_cmax = 0.0_wp                      !! the largest wave speed after it
+                                                        !! (`max_wave_speed`) [m/s]
   contains
     procedure :: finalize_setup => model_finalize_setup
   end type empm_model_t

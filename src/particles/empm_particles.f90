@@ -10,6 +10,7 @@ module empm_particles
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, empm_alloc_error, empm_raise_error
   use empm_strings, only: str
+  use empm_screen, only: empm_screen_finite, empm_screen_finite2
   implicit none
   private
   public :: empm_particles_t
@@ -50,9 +51,35 @@ module empm_particles
     procedure :: append => particles_append
     procedure :: copy_state_from => particles_copy_state
     procedure :: rewind_shape_state => particles_rewind_shape_state
+    procedure :: material_fields_fine => particles_material_fields_fine
   end type empm_particles_t
 
 contains
+
+  !> .true. when particles q0..q1 have a finite stress, strain and state and a finite, positive
+  !> density and volume: the screen of what a stress update writes, for the run-time guards
+  !> (sums of the values, [[empm_screen_finite]]: .false. may also be a false alarm, which the
+  !> guards' detailed search then clears).
+  pure logical function particles_material_fields_fine(self, q0, q1) result(fine)
+    class(empm_particles_t), intent(in) :: self !! particles
+    integer, intent(in) :: q0                   !! first particle
+    integer, intent(in) :: q1                   !! last particle (< q0: none)
+    integer :: n, p
+    real(wp) :: low
+    fine = .true.
+    n = q1 - q0 + 1
+    if (n < 1) return
+    fine = empm_screen_finite2(6 * n, self%stress(1, q0), self%strain(1, q0))
+    if (fine) fine = empm_screen_finite2(n, self%rho(q0), self%vol(q0))
+    if (fine .and. self%nstate > 0) fine = empm_screen_finite(self%nstate * n, self%state(1, q0))
+    if (.not. fine) return
+    ! Only on finite values: a comparison with a NaN would trap in a debug build.
+    low = huge(1.0_wp)
+    do p = q0, q1
+      low = min(low, self%rho(p), self%vol(p))
+    end do
+    fine = low > 0.0_wp
+  end function particles_material_fields_fine
 
   !> Allocate storage for `capacity` particles and set `np = 0`. On an allocation failure the
   !> set is left empty and unallocated, and the error says how much memory was asked for: in

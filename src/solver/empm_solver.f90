@@ -14,12 +14,16 @@ module empm_solver
   use empm_history, only: empm_history_t
   use empm_shape, only: shape_status_text, SHAPE_OUTSIDE_GRID
   use empm_terminal, only: stderr_is_terminal
+  use empm_screen, only: empm_screen_finite2, empm_screen_finite3
   implicit none
   private
   public :: empm_run_params
   public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies, empm_check_guards
   public :: empm_run_stats_t, empm_run_summary
   public :: empm_run_hook_t, empm_solver_state_t
+
+  !> Particles per block of the time loop's screen of positions, velocities and accelerations.
+  integer, parameter :: SCREEN_BLOCK = 256
 
   !> How to run: end time, time step control, output sampling.
   type :: empm_run_config_t
@@ -140,19 +144,20 @@ contains
     real(wp), intent(out) :: estrain        !! Σ V ψ [J]
     real(wp), intent(out) :: egrav          !! −Σ m g(t)·x [J]
     real(wp) :: g(3)
-    integer :: r, i0, i1, np, d
-    np = model%pts%np; d = model%grid%ndim
-    ekin = 0.5_wp * sum(model%pts%m(1:np) * sum(model%pts%v(:, 1:np)**2, dim=1))
+    integer :: r, i0, i1, np
+    np = model%pts%np
+    g = model%loads%gravity_at(model%t)
+    ekin = 0.0_wp; egrav = 0.0_wp
+    call motion_energies(model, 1, np, g, ekin, egrav)
+    ekin = 0.5_wp * ekin
     estrain = 0.0_wp
     do r = 1, size(model%run_first)
       i0 = model%run_first(r); i1 = model%run_last(r)
       call model%mats(model%pts%mat(i0))%model%energy_density(model%pts%F(:, :, i0:i1), &
         model%pts%strain(:, i0:i1), model%pts%stress(:, i0:i1), model%pts%state(:, i0:i1), &
         psi(i0:i1))
-      estrain = estrain + sum(model%pts%vol(i0:i1) * psi(i0:i1))
     end do
-    g = model%loads%gravity_at(model%t)
-    egrav = -sum(model%pts%m(1:np) * matmul(g(1:d), model%pts%x(:, 1:np)))
+    estrain = stored_energy(model, psi)
   end subroutine empm_energies
 
   !> Run `model` with `integ` until `cfg%t_end`. Records energies, probes and snapshots in
@@ -184,7 +189,7 @@ contains
     ! each step cost as much as a linear step): a guard stop restores it and replays the
     ! steps since with their recorded time steps, which gives the state before the failing
     ! step bitwise (the step is deterministic for a given number of threads).
-    integer, parameter :: KEEP_EVERY = 64
+    integer, parameter :: KEEP_EVERY = 128
     real(wp) :: dts(KEEP_EVERY), t_prev
     real(wp), allocatable :: xprev(:,:)
     integer :: nrep
@@ -198,7 +203,7 @@ contains
     real(wp) :: dt, dt_stable, ekin, estr, egrav, t_good, t_next_snap
     integer :: isnap, nsnap, step_good
     integer(int64) :: clock0, clock_last, clock, rate
-    logical :: show, tty
+    logical :: show, tty, sample, suspect, summed
     type(empm_run_stats_t) :: st
     real(wp) :: t_report
     character(len=:), allocatable :: msg
@@ -225,6 +230,12 @@ contains
     if (e%code == 0) then
       allocate(psi(model%pts%np), stat=astat, errmsg=amsg)
       if (astat /= 0) e = empm_alloc_error('energy scratch', 8_int64 * model%pts%np, amsg)
+    end if
+    if (e%code == 0) then
+      ! The stress update's energy densities of a sampled step (model%want_energy).
+      if (allocated(model%diag_psi)) deallocate(model%diag_psi)
+      allocate(model%diag_psi(model%pts%np), stat=astat, errmsg=amsg)
+      if (astat /= 0) e = empm_alloc_error('energy densities', 8_int64 * model%pts%np, amsg)
     end if
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
@@ -264,7 +275,13 @@ contains
         call fail('the step cap max_steps = '//str(cfg%max_steps)//' was reached at t = '// &
                   str(model%t)//' s before t_end'); return
       end if
-      dt_stable = empm_stable_dt(model)
+      ! The last stress update gave c_max while its blocks were in cache (fine values only:
+      ! with a failed screen the guards have stopped the run); the same maximum.
+      if (model%diag_step == model%step .and. model%diag_fine .and. model%diag_cmax > 0.0_wp) then
+        dt_stable = model%grid%hmin() / model%diag_cmax
+      else
+        dt_stable = empm_stable_dt(model)
+      end if
       if (cfg%dt > 0.0_wp) then
         dt = cfg%dt
         if (dt > dt_stable) then
@@ -286,6 +303,10 @@ contains
       end if
       t_prev = model%t
       if (ramping) xprev = model%pts%x(:, 1:model%pts%np)
+      ! A sampled step: the stress update sums the stored energy while its blocks are in cache
+      ! (the same test as the sampling below, on the same sums).
+      model%want_energy = mod(model%step + 1, cfg%history_every) == 0 .or. &
+        model%t + dt >= cfg%t_end
       call integ%step(model, dt, stat)
       nrep = nrep + 1; dts(nrep) = dt
       model%step = model%step + 1
@@ -294,18 +315,30 @@ contains
         call restore(); call fail(msg, stat%particle); return
       end if
       model%t = model%t + dt
-      msg = empm_check_guards(model)
-      if (len(msg) > 0) then
-        call restore(); call fail(msg); return
+      ! The screen reads x, v, a and the nodal fields once (and sums the energies of a sampled
+      ! step from them); the detailed search (the same verdict, with the first offender named)
+      ! runs only when it fails.
+      sample = mod(model%step, cfg%history_every) == 0 .or. model%t >= cfg%t_end
+      call screen_step(model, sample, suspect, ekin, egrav, summed)
+      if (suspect) then
+        msg = empm_check_guards(model)
+        if (len(msg) > 0) then
+          call restore(); call fail(msg); return
+        end if
       end if
       st%steps = st%steps + 1
       st%dt_min = min(st%dt_min, dt); st%dt_max = max(st%dt_max, dt)
       call add_gravity_work()
 
-      if (mod(model%step, cfg%history_every) == 0 .or. model%t >= cfg%t_end) then
-        call empm_energies(model, psi, ekin, estr, egrav)
+      if (sample) then
+        if (summed .and. model%want_energy .and. model%diag_step == model%step) then
+          estr = stored_energy(model, model%diag_psi)
+        else
+          call empm_energies(model, psi, ekin, estr, egrav)
+        end if
         call hist%add_sample(model%t, ekin, estr, egrav, model%pts, model)
       end if
+      model%want_energy = .false.
       call skip_past_snapshots()
       if (show) call progress()
       if (present(hook)) then
@@ -505,6 +538,119 @@ contains
       end if
     end function describe_status
   end subroutine empm_solve
+
+  !> After a step: the guards' cheap test (`suspect` = .false. only when [[empm_check_guards]]
+  !> would return '') and, with `sample`, the kinetic and gravitational energies as
+  !> [[empm_energies]] sums them (`done` then; not when the screen failed first). The material
+  !> fields count as screened when this step's stress update screened them
+  !> (`model%diag_step`); otherwise they are read here. Positions, velocities and accelerations
+  !> are read once, block by block: the screen of their sums, the extreme coordinates (against
+  !> the grid box and the mirror planes, with the detailed check's expressions) and the energies
+  !> from the block in cache; then the nodal velocities and accelerations.
+  subroutine screen_step(model, sample, suspect, ekin, egrav, done)
+    type(empm_model_t), intent(in) :: model !! simulation state
+    logical, intent(in) :: sample           !! sum the energies too
+    logical, intent(out) :: suspect         !! the detailed check may find something
+    real(wp), intent(out) :: ekin           !! Σ ½ m |v|² [J] (with `done`)
+    real(wp), intent(out) :: egrav          !! −Σ m g(t)·x [J] (with `done`)
+    logical, intent(out) :: done            !! the energies were summed
+    real(wp) :: lo(3), hi(3), upper, side, g(3), xlo, xhi
+    integer :: np, nd, p, k, I, nn, q0, q1, n
+    np = model%pts%np; nd = model%grid%ndim; nn = model%nodes%nnode
+    suspect = .true.; done = .false.; ekin = 0.0_wp; egrav = 0.0_wp
+    if (model%diag_step == model%step) then
+      if (.not. model%diag_fine) return
+    else
+      if (.not. model%pts%material_fields_fine(1, np)) return
+    end if
+    g = model%loads%gravity_at(model%t)
+    lo = huge(1.0_wp); hi = -huge(1.0_wp)
+    associate (x => model%pts%x)
+      do q0 = 1, np, SCREEN_BLOCK
+        q1 = min(np, q0 + SCREEN_BLOCK - 1); n = nd * (q1 - q0 + 1)
+        if (.not. empm_screen_finite3(n, x(1, q0), model%pts%v(1, q0), model%pts%a(1, q0))) &
+          return
+        ! Finite now: min and max cannot meet a NaN (which would trap in a debug build). One
+        ! direction at a time, into scalars: the loop over the block then vectorises.
+        do k = 1, nd
+          xlo = lo(k); xhi = hi(k)
+          do p = q0, q1
+            xlo = min(xlo, x(k, p)); xhi = max(xhi, x(k, p))
+          end do
+          lo(k) = xlo; hi(k) = xhi
+        end do
+        if (sample) call motion_energies(model, q0, q1, g, ekin, egrav)
+      end do
+    end associate
+    do k = 1, nd
+      upper = model%grid%origin(k) + model%grid%ncell(k) * model%grid%h(k)
+      if (np > 0 .and. .not. (lo(k) >= model%grid%origin(k) .and. hi(k) <= upper)) return
+    end do
+    do I = 1, model%nodes%nplane
+      k = abs(model%nodes%plane_side(I))
+      side = sign(1.0_wp, real(model%nodes%plane_side(I), wp))
+      if (np > 0 .and. side * (merge(hi(k), lo(k), side > 0.0_wp) - model%nodes%plane_at(I)) > &
+          1.0e-9_wp * model%grid%h(k)) return
+    end do
+    if (nn > 0) then
+      if (.not. empm_screen_finite2(nd * nn, model%nodes%vel, model%nodes%acc)) return
+    end if
+    suspect = .false.
+    ekin = 0.5_wp * ekin
+    done = sample
+  end subroutine screen_step
+
+  ! Add Σ m |v|² and −Σ m g·x of particles q0..q1 to ekin and egrav, one particle after the
+  ! other in index order (the order of every earlier version: the energy metrics of the
+  ! verification summary are differences of nearly equal energies, sensitive to the last bit).
+  subroutine motion_energies(model, q0, q1, g, ekin, egrav)
+    type(empm_model_t), intent(in) :: model
+    integer, intent(in) :: q0, q1
+    real(wp), intent(in) :: g(3)
+    real(wp), intent(inout) :: ekin, egrav
+    real(wp) :: vv, gx
+    integer :: k, p
+    associate (v => model%pts%v, x => model%pts%x, m => model%pts%m)
+      select case (model%grid%ndim)
+      case (2)
+        do p = q0, q1
+          ekin = ekin + m(p) * (v(1, p)**2 + v(2, p)**2)
+          egrav = egrav - m(p) * (g(1) * x(1, p) + g(2) * x(2, p))
+        end do
+      case (3)
+        do p = q0, q1
+          ekin = ekin + m(p) * ((v(1, p)**2 + v(2, p)**2) + v(3, p)**2)
+          egrav = egrav - m(p) * ((g(1) * x(1, p) + g(2) * x(2, p)) + g(3) * x(3, p))
+        end do
+      case default
+        do p = q0, q1
+          vv = 0.0_wp; gx = 0.0_wp
+          do k = 1, model%grid%ndim
+            vv = vv + v(k, p)**2
+            gx = gx + g(k) * x(k, p)
+          end do
+          ekin = ekin + m(p) * vv
+          egrav = egrav - m(p) * gx
+        end do
+      end select
+    end associate
+  end subroutine motion_energies
+
+  ! Σ V ψ, run by run, each run's sum added to the total (the order of every earlier version).
+  function stored_energy(model, psi) result(e)
+    type(empm_model_t), intent(in) :: model
+    real(wp), intent(in) :: psi(:)
+    real(wp) :: e, er
+    integer :: r, p
+    e = 0.0_wp
+    do r = 1, size(model%run_first)
+      er = 0.0_wp
+      do p = model%run_first(r), model%run_last(r)
+        er = er + model%pts%vol(p) * psi(p)
+      end do
+      e = e + er
+    end do
+  end function stored_energy
 
   !> Check particle and nodal fields after a step (state variables included: they must stay
   !> finite); returns '' when all is well, otherwise a message naming the step, the particle or

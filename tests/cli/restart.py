@@ -17,7 +17,7 @@
   seconds   checkpoints by wall time (checkpoint_seconds): written during the run, and the
             restart from the one before the last is bitwise.
   guard     a guard stop after more steps than the kept copy spans (the solver keeps the state
-            every 64 steps and replays the steps since): the last good state written equals,
+            every 128 steps and replays the steps since): the last good state written equals,
             bitwise, the state of the same run stopped before the failing step by max_steps.
   refuse    a checkpoint of another case file (one value changed), of another version, a
             damaged one, a results file and a missing file: each refused with status 2 and
@@ -283,8 +283,8 @@ def seconds(empm, work):
 
 
 def guard(empm, work):
-    # A bar thrown towards the end of its grid: it leaves it after about 150 steps.
-    text = """&grid ndim = 1, h = 0.05, cells = 40 /
+    # A bar thrown towards the end of its grid: it leaves it after about 300 steps.
+    text = """&grid ndim = 1, h = 0.05, cells = 60 /
 &shape family = '{shape}' /
 &material name = 'm', model = 'linear_elastic', E = 100.0, density = 1.0 /
 &particles material = 'm', geometry = 'interval', lo = 0.0, hi = 1.0, ppc = 2, velocity = 0.1 /
@@ -304,7 +304,7 @@ def guard(empm, work):
         if steps is None:
             # The step of the last good state: from the failing step in the message.
             steps = int(p.stderr.split("step ")[1].split(":")[0]) - 1
-        if steps <= 64:
+        if steps <= 128:
             fail(f"{shape}: the guard tripped at step {steps + 1}, within the first kept copy")
         capped = os.path.join(work, f"c_{shape}.nml")
         with open(capped, "w") as f:
