@@ -4,9 +4,12 @@
 !> The converse fails only when finite terms overflow (|sum| > 1.8e308), which raises a false
 !> alarm, never a miss; so a screen that passes settles the matter and only one that fails
 !> needs the detailed search for the first offender. Additions into independent partial sums
-!> vectorise (a packed add takes two values), carry no branch, and raise no floating-point
-!> exception on a quiet NaN; screening values a pass has just written (still in cache) costs
-!> well under a nanosecond per particle.
+!> vectorise (a packed add takes two values) and carry no branch; screening values a pass has
+!> just written (still in cache) costs well under a nanosecond per particle. A quiet NaN raises
+!> no floating-point exception; +Inf meeting −Inf (invalid) and an overflowing sum (overflow)
+!> do, which a debug build traps: there the operation that made the Inf has trapped first,
+!> unless it came from outside (an API call), and the trap then stops the run instead of the
+!> guard (tests/unit/test_screen.pf runs the screens with those traps off).
 module empm_screen
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use empm_kinds, only: wp
