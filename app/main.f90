@@ -12,7 +12,8 @@ program empm_main
   use empm_input, only: empm_input_markdown
   use empm_bench, only: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json
   implicit none
-  integer :: nargs, i, ios, nfail, npat, nthreads
+  integer :: nargs, i, ios, nfail, npat, nthreads, envlen, envstat
+  logical :: auto
   character(len=:), allocatable :: cmd, case_file, out_file, written, manifest, outdir, restart
   character(len=256), allocatable :: patterns(:)
   character(len=64) :: numtext
@@ -58,13 +59,16 @@ program empm_main
     end do
     if (len(case_file) == 0) call die('empm run needs a case file: empm run CASE.nml')
     if (nthreads > 0) call empm_set_threads(nthreads)
+    ! Neither --threads nor OMP_NUM_THREADS: the threads follow the machine's idle cores.
+    call get_environment_variable('OMP_NUM_THREADS', length=envlen, status=envstat)
+    auto = nthreads == 0 .and. (envstat /= 0 .or. envlen == 0)
     ! Beyond the file-size limit (ulimit -f) a write fails and is reported (status 4).
     call empm_ignore_sigxfsz()
     ! Ctrl-C or a batch system's SIGTERM: a checkpoint and the results so far, then exit.
     call empm_catch_stop_signals()
     ! A verification case file also runs: its &verify group is the suite's, not the run's.
     call empm_run_case(case_file, out_file, written=written, err=err, extra_groups='verify', &
-                       stats=stats, restart=restart)
+                       stats=stats, restart=restart, auto_threads=auto)
     ! The summary also for a run stopped by a guard (whenever the time loop ran).
     if (stats%ran) write(output_unit, '(a)', iostat=ios) 'empm: '//empm_run_summary(stats)
     if (err%code == EMPM_ERR_INTERRUPTED) then
@@ -194,7 +198,8 @@ contains
     write(u, '(a)') 'snapshot is the state at t = 0.'
     write(u, '(a)') ''
     write(u, '(a)') '  -o, --output OUT.h5  output file (default: the &output file, else CASE.h5)'
-    write(u, '(a)') '  -t, --threads N      OpenMP threads (default: OMP_NUM_THREADS or all cores)'
+    write(u, '(a)') '  -t, --threads N      OpenMP threads (default: OMP_NUM_THREADS, else the cores'
+    write(u, '(a)') '                       other processes leave idle at the start, at most all)'
     write(u, '(a)') '  -r, --restart CKPT.h5  continue from a checkpoint of this case file (written'
     write(u, '(a)') '                       with &output checkpoint_every / checkpoint_seconds, or'
     write(u, '(a)') '                       on SIGINT/SIGTERM): the results equal an uninterrupted'

@@ -165,6 +165,7 @@ def main():
     md.append("")
     md += materials_section(Path(sys.argv[1]).with_name("materials.jsonl"), rev)
     md += run_path_section(Path(sys.argv[1]).with_name("runpath.jsonl"))
+    md += threads_section(Path(sys.argv[1]).with_name("threads.jsonl"))
     (out / "performance.md").write_text("\n".join(md))
     print(f"wrote {out / 'performance.md'} and {out / 'performance.png'}")
 
@@ -245,6 +246,44 @@ def run_path_section(path):
                   f"{fmt(statistics.median(benches))} | {rmed:.3f} "
                   f"({min(ratios):.3f}–{max(ratios):.3f}) | ≤ 1.10 | "
                   f"{'yes' if rmed <= 1.10 else '**no**'} |")
+    md.append("")
+    return md
+
+
+def threads_section(path):
+    """`empm run`'s default thread count beside a busy process (issue 17, item 4): the wall
+    time of each setting per round, medians, and the default against one thread."""
+    if not path.exists():
+        return []
+    runs = {}
+    with open(path) as f:
+        for line in f:
+            d = json.loads(line)
+            runs.setdefault((d["load"], d["round"]), {})[d["threads"]] = d["run_seconds"]
+    md = ["## Threads beside a busy process (issue 17, item 4)", "",
+          "`benchmarks/run --threads`: `empm run` on the 2D block of 262,144 particles (linear, "
+          "pc_newmark, 120 steps) with the default thread count (no `--threads`, no "
+          "`OMP_NUM_THREADS`: the cores other processes leave idle at the start), with "
+          "`--threads 1` and `--threads 2`, on the idle machine and beside one busy process "
+          "(with the run, one more busy process than the 2 cores); interleaved rounds, wall "
+          "time of the time loop in s, median (range). Ratio: default / 1 thread per round, "
+          "median (range); met when the median is at most 1.05 (this machine's run-to-run "
+          "noise is ±10 %).", "",
+          "| load | default | 1 thread | 2 threads | default / 1 thread | target | met |",
+          "|---|---|---|---|---|---|---|"]
+    for load in ("idle", "busy"):
+        rs = [v for (l, _), v in sorted(runs.items()) if l == load]
+        if not rs:
+            continue
+        col = {t: [r[t] for r in rs if t in r] for t in ("default", "1", "2")}
+        ratios = [r["default"] / r["1"] for r in rs if "default" in r and "1" in r]
+        cell = {t: f"{statistics.median(v):.2f} ({min(v):.2f}–{max(v):.2f})" if v else ""
+                for t, v in col.items()}
+        rmed = statistics.median(ratios)
+        target, met = ("≤ 1 (not slower)", "yes" if rmed <= 1.05 else "**no**") \
+            if load == "busy" else ("", "")
+        md.append(f"| {load} | {cell['default']} | {cell['1']} | {cell['2']} | {rmed:.2f} "
+                  f"({min(ratios):.2f}–{max(ratios):.2f}) | {target} | {met} |")
     md.append("")
     return md
 

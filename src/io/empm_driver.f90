@@ -1,7 +1,7 @@
 !> High-level driver: read a case file, run it, write the results. Used by the `empm run`
 !> command and callable from embedding codes.
 module empm_driver
-  use, intrinsic :: iso_fortran_env, only: error_unit
+  use, intrinsic :: iso_fortran_env, only: error_unit, int64
   use empm_error, only: empm_error_t, empm_raise_error, EMPM_OK, EMPM_ERR_INTERRUPTED
   use empm_case, only: empm_case_t
   use empm_input, only: empm_read_case
@@ -11,7 +11,10 @@ module empm_driver
   use empm_output, only: empm_write_results, empm_output_meta_t, empm_output_claim, &
     empm_output_release
   use empm_checkpoint, only: empm_checkpoint_write, empm_checkpoint_read, empm_checkpoint_path
-  use empm_posix, only: empm_stop_signal
+  use empm_posix, only: empm_stop_signal, empm_sleep
+  use empm_parallel, only: empm_cpu_sample_t, empm_cpu_sample, empm_threads_for_load, &
+                           empm_max_threads, empm_set_threads, EMPM_OMP_MIN_PARTICLES
+  use empm_strings, only: str
   implicit none
   private
   public :: empm_run_case
@@ -59,7 +62,7 @@ contains
   !> empm_catch_stop_signals) ends the run after the current step with a checkpoint and the
   !> results so far (marked incomplete), error code EMPM_ERR_INTERRUPTED.
   subroutine empm_run_case(path, output, progress, written, err, extra_groups, stats, &
-                           initial_snapshot, restart)
+                           initial_snapshot, restart, auto_threads)
     character(len=*), intent(in) :: path                !! case file
     character(len=*), intent(in), optional :: output    !! output HDF5 path override
     logical, intent(in), optional :: progress           !! progress on stderr (default on; false
@@ -75,6 +78,12 @@ contains
                                                         !! (default true)
     character(len=*), intent(in), optional :: restart   !! checkpoint to continue from ('' or
                                                         !! absent: start afresh)
+    logical, intent(in), optional :: auto_threads       !! choose the OpenMP threads from the
+                                                        !! machine's load (`empm run` without
+                                                        !! --threads or OMP_NUM_THREADS): as
+                                                        !! many as the cores other processes
+                                                        !! leave idle over the set-up (at least
+                                                        !! 0.2 s), at most the current number
     type(empm_case_t) :: cs
     type(driver_hook_t) :: hook
     type(empm_solver_state_t) :: sst
@@ -84,7 +93,9 @@ contains
     type(empm_error_t) :: e, ew
     type(empm_output_meta_t) :: meta
     logical :: add0
+    type(empm_cpu_sample_t) :: load0
 
+    call empm_cpu_sample(load0)
     call empm_read_case(path, cs, e, extra_groups=extra_groups)
     if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
@@ -93,6 +104,9 @@ contains
       if (len_trim(output) > 0) cs%output_file = trim(output)
     end if
     if (present(progress)) cs%run%progress = progress
+    if (present(auto_threads)) then
+      if (auto_threads) call choose_threads()
+    end if
     call empm_output_claim(cs%output_file, e)
     if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
@@ -147,5 +161,29 @@ contains
     else if (ew%code /= EMPM_OK) then
       call empm_raise_error(ew, err)
     end if
+
+  contains
+
+    ! Threads for a run that can use them (EMPM_OMP_MIN_PARTICLES or more): the cores other
+    ! processes left idle since the start of the set-up, measured over at least 0.2 s.
+    subroutine choose_threads()
+      type(empm_cpu_sample_t) :: load1
+      integer :: nmax, n
+      real :: other, waited
+      nmax = empm_max_threads()
+      if (nmax <= 1 .or. cs%model%pts%np < EMPM_OMP_MIN_PARTICLES) return
+      call empm_cpu_sample(load1)
+      waited = real(load1%clock - load0%clock) / real(max(1_int64, load1%rate))
+      if (waited < 0.2) then
+        call empm_sleep(0.2 - waited)
+        call empm_cpu_sample(load1)
+      end if
+      call empm_threads_for_load(load0, load1, nmax, n, other)
+      if (n == nmax) return
+      call empm_set_threads(n)
+      if (cs%run%progress) write(error_unit, '(a, f0.1, a)') 'empm: '//str(n)//' thread'// &
+        trim(merge('s', ' ', n > 1))//' of '//str(nmax)//': other processes keep ', other, &
+        ' cores busy (--threads N or OMP_NUM_THREADS to choose)'
+    end subroutine choose_threads
   end subroutine empm_run_case
 end module empm_driver

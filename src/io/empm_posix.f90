@@ -1,15 +1,17 @@
 !> Operating-system queries the output needs and Fortran does not offer (POSIX and Linux
 !> through C interoperability): the process id and whether a process is alive (output locks),
 !> the kind of an existing path (an output must be a regular file), the text of `errno` (the
-!> reason of a failed write) and ignoring SIGXFSZ (so that exceeding the file-size limit is a
-!> failed write, reported, not a killed process).
+!> reason of a failed write), ignoring SIGXFSZ (so that exceeding the file-size limit is a
+!> failed write, reported, not a killed process) and a short sleep (the thread choice of
+!> `empm run` measuring the machine's load).
 module empm_posix
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_funptr, &
     c_intptr_t, c_f_pointer, c_associated, c_int16_t, c_funloc
   implicit none
   private
   public :: empm_getpid, empm_process_alive, empm_path_kind, empm_errno, empm_errno_text, &
-            empm_ignore_sigxfsz, empm_catch_stop_signals, empm_stop_signal, empm_write_reason
+            empm_ignore_sigxfsz, empm_catch_stop_signals, empm_stop_signal, empm_write_reason, &
+            empm_sleep
   public :: PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY, PATH_OTHER
 
   integer, parameter :: PATH_MISSING = 0   !! nothing at the path (or it cannot be examined)
@@ -43,6 +45,11 @@ module empm_posix
       integer(c_int), value :: errnum
       type(c_ptr) :: p
     end function c_strerror
+    function c_usleep(usec) bind(C, name='usleep') result(r)
+      import :: c_int
+      integer(c_int), value :: usec
+      integer(c_int) :: r
+    end function c_usleep
     function c_signal(sig, handler) bind(C, name='signal') result(old)
       import :: c_int, c_funptr
       integer(c_int), value :: sig
@@ -62,6 +69,13 @@ module empm_posix
                         S_IFDIR = int(o'040000')
 
 contains
+
+  !> Sleep for `seconds` (at most 1 s at a time; interrupted early by a signal).
+  subroutine empm_sleep(seconds)
+    real, intent(in) :: seconds !! duration [s], 0 to 1
+    integer(c_int) :: r
+    r = c_usleep(int(max(0.0, min(1.0, seconds)) * 1.0e6, c_int))
+  end subroutine empm_sleep
 
   !> The id of this process.
   integer function empm_getpid() result(pid)
