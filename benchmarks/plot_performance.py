@@ -58,7 +58,8 @@ def main():
     bw = [r for r in rows if r["tag"] == "bandwidth"]
 
     fig, (ax1, ax2) = plt.subplots(1, 2, figsize=(11, 4.2))
-    for shape, style in [("linear", "o-"), ("lme_g3", "s-")]:
+    for shape, style in [("linear", "o-"), ("ugimp", "v--"), ("bspline2", "^-."),
+                         ("bspline3", "D:"), ("lme_g3", "s-")]:
         pts = sorted((r["particles"], r["particle_steps_per_second"]) for r in sweep
                      if r["shape"] == shape)
         if pts:
@@ -141,6 +142,16 @@ def main():
     for r in sorted(sweep, key=lambda x: (x["shape"], x["particles"])):
         md.append(f'| {r["shape"]} | {r["particles"]} | {r["steps"]} | '
                   f'{fmt(r["particle_steps_per_second"])} | {r["bytes_per_particle"]:.0f} |')
+    if sweep:
+        md += ["", "Flatness (issue 17, item 5): the cost per particle-step at the largest size "
+               "against the smallest, and the spread (slowest against fastest) over the sizes.", "",
+               "| shape | sizes | 1e6 / 1e4 cost | max / min cost |", "|---|---|---|---|"]
+        for shape in sorted({r["shape"] for r in sweep}):
+            pts = sorted((r["particles"], r["particle_steps_per_second"]) for r in sweep
+                         if r["shape"] == shape)
+            rates = [t for _, t in pts]
+            md.append(f"| {shape} | {len(pts)} | {pts[0][1] / pts[-1][1]:.2f} | "
+                      f"{max(rates) / min(rates):.2f} |")
     if grind:
         md += ["", "## Instructions per particle-step (callgrind)", "",
                "`benchmarks/callgrind_count.py`: 2D, 4096 particles, pc_newmark, 1 thread; the "
