@@ -130,6 +130,7 @@ program empm_main
       case ('--material');   bcfg%material = arg(i + 1)
       case ('--material-keys'); bcfg%material_keys = arg(i + 1)
       case ('--case');       bcfg%case_file = arg(i + 1)
+      case ('--motion');     bcfg%motion = arg(i + 1)
       case ('--confinement')
         numtext = arg(i + 1)
         read(numtext, *, iostat=ios) bcfg%confinement
@@ -238,7 +239,7 @@ contains
     write(u, '(a)') 'usage: empm bench [--dim 2|3] [--shape S] [--cells N] [--ppc P] [--steps K]'
     write(u, '(a)') '                  [--threads T] [--integrator I] [--warmup W]'
     write(u, '(a)') '                  [--material M] [--material-keys ''k = v, ...'']'
-    write(u, '(a)') '                  [--confinement P0] [--min-fill F]'
+    write(u, '(a)') '                  [--confinement P0] [--min-fill F] [--motion vibrate|rotate]'
     write(u, '(a)') '       empm bench --case FILE [--steps K] [--warmup W] [--threads T]'
     write(u, '(a)') ''
     write(u, '(a)') 'Times a freely vibrating block (N^dim cells, P particles per cell) and'
@@ -257,6 +258,9 @@ contains
     write(u, '(a)') 'relative to the working folder. F is the fill below which nodes are extended'
     write(u, '(a)') '(&grid min_fill; default 0.1, 0: off). "plastic_fraction" in the output is the'
     write(u, '(a)') 'share of particle updates that changed a state variable.'
+    write(u, '(a)') 'With --motion rotate the block spins about its centre instead (corner speed'
+    write(u, '(a)') '0.1 of the P-wave speed: a corner crosses a cell every ~20 steps), on a grid'
+    write(u, '(a)') 'a quarter larger on every side: particles move through cells, as in a run.'
     write(u, '(a)') ''
     write(u, '(a)') 'With --case, the model, integrator and time step of a case file are timed'
     write(u, '(a)') 'instead of the block (its dt, or cfl times the stable step at the start):'

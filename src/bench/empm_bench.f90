@@ -62,6 +62,12 @@ module empm_bench
     real(wp) :: confinement = -1.0_wp                !! initial isotropic compression p0 [Pa]
                                                      !! (< 0: the model's bench default)
     real(wp) :: min_fill = -1.0_wp                   !! `&grid min_fill` (< 0: the default)
+    character(len=16) :: motion = 'vibrate'          !! 'vibrate': the standing wave, the
+                                                     !! particles barely move; 'rotate': the
+                                                     !! block spins about its centre (axis z),
+                                                     !! its corners crossing a cell every ~20
+                                                     !! steps, on a grid a quarter larger
+                                                     !! on every side
     character(len=1024) :: case_file = ''            !! time this case file's model instead of
                                                      !! the block ('': the block); the other
                                                      !! fields but steps, warmup and threads
@@ -76,6 +82,7 @@ module empm_bench
     character(len=:), allocatable :: material           !! material model
     character(len=:), allocatable :: material_keys      !! the keys it was created with
     real(wp) :: confinement = 0.0_wp                    !! initial isotropic compression [Pa]
+    character(len=:), allocatable :: motion             !! 'vibrate', 'rotate' or 'case'
     real(wp) :: plastic_fraction = 0.0_wp               !! particle updates that changed a
                                                         !! state variable / all (timed steps)
     integer :: particles = 0                            !! particles
@@ -136,7 +143,14 @@ contains
     if (e%code /= 0) then
       call empm_raise(EMPM_ERR_USAGE, 'bench: --shape: '//e%message, err); return
     end if
+    if (cfg%motion /= 'vibrate' .and. cfg%motion /= 'rotate') then
+      call empm_raise(EMPM_ERR_USAGE, 'bench: --motion must be vibrate or rotate, not '// &
+        trim(cfg%motion), err); return
+    end if
     pad = model%shape%padding_cells()
+    ! A rotating block sweeps the disk of radius √2/2 about (½, ½): a quarter more grid on
+    ! every side holds it while it turns through 45°.
+    if (cfg%motion == 'rotate') pad = pad + (cfg%cells + 3) / 4
     origin = -pad * h
     ncell = cfg%cells + 2 * pad
     call model%grid%init(nd, origin(1:nd), h(1:nd), ncell(1:nd), info)
@@ -168,7 +182,18 @@ contains
     do p = 1, model%pts%np
       model%pts%stress(1:3, p) = -p0
     end do
+    ! Rotation about the block's axis (x, y) = (½, ½): v = ω ẑ × (x − c), corner speed
+    ! 0.1 c_P (c_P = 116 m/s): a corner crosses a cell every ~20 steps at Δt = ½ h/c_P.
+    if (cfg%motion == 'rotate') then
+      s = 0.1_wp * bench_wave_speed() / sqrt(0.5_wp)
+      do p = 1, model%pts%np
+        model%pts%v(:, p) = 0.0_wp
+        model%pts%v(1, p) = -s * (model%pts%x(2, p) - 0.5_wp)
+        model%pts%v(2, p) = s * (model%pts%x(1, p) - 0.5_wp)
+      end do
+    end if
     ! Standing wave: component d varies as sin(π(d+k)x_k)-like products, zero on the faces.
+    if (cfg%motion == 'vibrate') then
     do p = 1, model%pts%np
       do d = 1, nd
         s = BENCH_V0
@@ -178,6 +203,7 @@ contains
         model%pts%v(d, p) = s
       end do
     end do
+    end if
     ! A confined block must stay confined: a free block under −p0 I is not in equilibrium and
     ! would expand (a Cam-Clay block by far more than the grid). The walls x_k = 0 and 1 are
     ! smooth and rigid (normal velocity 0; the standing wave's normal component vanishes there).
@@ -196,6 +222,7 @@ contains
     dt = 0.5_wp * empm_stable_dt(model)
     call time_steps(model, integ, dt, cfg, rss0, res, err)
     if (allocated(res%shape)) then
+      res%motion = trim(cfg%motion)
       res%material = trim(cfg%material)
       res%material_keys = mkeys
       res%confinement = p0
@@ -300,6 +327,7 @@ contains
     call time_steps(cs%model, cs%integ, dt, cfg, rss0, res, err)
     if (.not. allocated(res%shape)) return
     res%material = cs%model%mats(1)%model%family()
+    res%motion = 'case'
     res%material_keys = ''
     res%confinement = 0.0_wp
   end subroutine bench_case
@@ -308,6 +336,12 @@ contains
   !> elastic stiffness K = v p'/κ vanishes with p'; with OCR = 1 the block starts on the yield
   !> surface, so its vibration loads it plastically), 0 for the other models. The block's faces are free:
   !> they unload, and the corner particle fails after ~8 steps (a camclay weakness reported).
+  !> P-wave speed of the bench's material, sqrt(E(1 − ν)/((1 + ν)(1 − 2ν))/ρ) [m/s].
+  pure real(wp) function bench_wave_speed() result(c)
+    c = sqrt(BENCH_E * (1.0_wp - BENCH_NU) / ((1.0_wp + BENCH_NU) * (1.0_wp - 2.0_wp * BENCH_NU)) &
+             / BENCH_RHO)
+  end function bench_wave_speed
+
   pure real(wp) function bench_confinement(name)
     character(len=*), intent(in) :: name !! registry name
     bench_confinement = merge(1.0e4_wp, 0.0_wp, name == 'camclay')
@@ -404,10 +438,14 @@ contains
   function empm_bench_json(res) result(s)
     type(empm_bench_result_t), intent(in) :: res !! measurements
     character(len=:), allocatable :: s           !! {"dim":2,"shape":"lme_g3",...}
+    character(len=:), allocatable :: motion
     integer :: k
+    motion = 'vibrate'
+    if (allocated(res%motion)) motion = res%motion
     s = '{"dim":'//str(res%dim)//',"shape":"'//res%shape//'","integrator":"'// &
       res%integrator//'","material":"'//res%material//'","material_keys":"'// &
-      res%material_keys//'","plastic_fraction":'//num(res%plastic_fraction)// &
+      res%material_keys//'","motion":"'//motion//'","plastic_fraction":'// &
+      num(res%plastic_fraction)// &
       ',"confinement":'//num(res%confinement)//',"particles":'//str(res%particles)//',"nodes":'//str(res%nodes)// &
       ',"steps":'//str(res%steps)//',"threads":'//str(res%threads)//',"seconds":'// &
       num(res%seconds)//',"particle_steps_per_second":'//num(res%particle_steps_per_second)// &
