@@ -145,6 +145,11 @@ contains
     integer :: p, pinfo
     call shape_batch_fits(pts%np, basis, ibad, info)
     if (info /= SHAPE_OK) return
+    if (self%order == 2 .and. .not. self%clamped .and. grid%ndim == 2 .and. basis%maxn >= 9 &
+        .and. size(basis%dN, 1) >= 2) then
+      call quadratic_2d_batch(grid, pts, basis, ibad, info)
+      return
+    end if
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
     !$omp parallel do default(none) schedule(static) shared(self, grid, pts, basis, ibad, info) &
@@ -157,6 +162,96 @@ contains
     !$omp end parallel do
     if (ibad == huge(1)) ibad = 0
   end subroutine bspline_eval_batch
+
+  !> The uniform quadratic B-splines in 2D for particles 1..pts%np, the hot case written out:
+  !> the arithmetic of [[shape_bspline_kernel]] (bspline_1d and shape_tp_assemble: the same
+  !> values, bitwise, and the same node lists, a node with a zero value dropped), without its
+  !> per-particle calls, work arrays and per-node index checks (they were ~40 % of a bspline2
+  !> step). `tests/unit/test_bspline_fast.pf` compares the two.
+  subroutine quadratic_2d_batch(grid, pts, basis, ibad, info)
+    type(empm_grid_t), intent(in) :: grid           !! background grid (2D)
+    type(empm_particles_t), intent(in) :: pts       !! particles
+    type(empm_basis_t), intent(inout) :: basis      !! node lists (maxn >= 9)
+    integer, intent(out) :: ibad                    !! first failing particle, 0 if none
+    integer, intent(out) :: info                    !! SHAPE_OK or the failing particle's code
+    real(wp) :: o(2), e(2), ih(2), w(3, 2), g(3, 2)
+    integer :: p, pinfo, m(2), base(2), n1, c(2), k1, k2, a, row
+    o = grid%origin(1:2); ih = grid%inv_h(1:2); c = grid%ncell(1:2)
+    e = grid%origin(1:2) + grid%ncell(1:2) * grid%h(1:2)
+    n1 = grid%nn(1)
+    ibad = huge(1); info = SHAPE_OK
+    !$omp parallel do default(none) schedule(static) &
+    !$omp   shared(pts, basis, ibad, info, o, e, ih, c, n1) &
+    !$omp   private(pinfo, m, base, w, g, k1, k2, a, row) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
+    do p = 1, pts%np
+      ! grid%inside
+      if (.not. (pts%x(1, p) >= o(1) .and. pts%x(1, p) <= e(1) .and. &
+                 pts%x(2, p) >= o(2) .and. pts%x(2, p) <= e(2))) then
+        basis%nn(p) = 0
+        call shape_keep_first_failure(p, SHAPE_OUTSIDE_GRID, ibad, info); cycle
+      end if
+      call factors(pts%x(1, p), o(1), ih(1), c(1), m(1), base(1), w(:, 1), g(:, 1), pinfo)
+      if (pinfo == SHAPE_OK) &
+        call factors(pts%x(2, p), o(2), ih(2), c(2), m(2), base(2), w(:, 2), g(:, 2), pinfo)
+      if (pinfo /= SHAPE_OK) then
+        basis%nn(p) = 0
+        call shape_keep_first_failure(p, pinfo, ibad, info); cycle
+      end if
+      ! shape_tp_assemble with m(3) = 1, w(1, 3) = 1 and g(1, 3) = 0: w23 = w(k2, 2) · 1 and
+      ! w13 = w(k1, 1) · 1 exactly.
+      a = 0
+      do k2 = 1, m(2)
+        row = 1 + base(1) + n1 * (base(2) + k2 - 1)
+        do k1 = 1, m(1)
+          a = a + 1
+          basis%node(a, p) = row + k1 - 1
+          basis%N(a, p) = w(k1, 1) * w(k2, 2)
+          basis%dN(1, a, p) = g(k1, 1) * w(k2, 2)
+          basis%dN(2, a, p) = g(k2, 2) * w(k1, 1)
+        end do
+      end do
+      basis%nn(p) = a
+    end do
+    !$omp end parallel do
+    if (ibad == huge(1)) ibad = 0
+
+  contains
+
+    ! bspline_1d for order 2 along one direction (s in cell units from the origin).
+    pure subroutine factors(xd, od, ihd, ncell, m, base, w, g, info)
+      real(wp), intent(in) :: xd, od, ihd
+      integer, intent(in) :: ncell
+      integer, intent(out) :: m, base
+      real(wp), intent(out) :: w(3), g(3)
+      integer, intent(out) :: info
+      real(wp) :: s, u, r
+      integer :: i, i1
+      m = 0; base = 0
+      s = (xd - od) * ihd
+      i1 = floor(s - 0.5_wp)
+      do i = i1, i1 + 2
+        u = s - i
+        r = abs(u)
+        if (r >= 1.5_wp) cycle
+        if (i < 0 .or. i > ncell) then
+          if (r < 1.5_wp - SHAPE_CLIP_TOL) then
+            info = SHAPE_SUPPORT_CLIPPED; return
+          end if
+          cycle
+        end if
+        if (m == 0) base = i
+        m = m + 1
+        if (r < 0.5_wp) then
+          w(m) = 0.75_wp - r * r
+          g(m) = -2.0_wp * u * ihd
+        else
+          w(m) = 0.5_wp * (1.5_wp - r)**2
+          g(m) = -sign(1.0_wp, u) * (1.5_wp - r) * ihd
+        end if
+      end do
+      info = SHAPE_OK
+    end subroutine factors
+  end subroutine quadratic_2d_batch
 
   !> B-spline shape functions of degree `order` at one point; only nodes with a nonzero value
   !> are returned, in increasing index order.

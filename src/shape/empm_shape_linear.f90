@@ -302,26 +302,31 @@ contains
     real(wp), intent(out) :: N(:)         !! values
     real(wp), intent(out) :: dN(:,:)      !! gradients (ndim, :)
     integer, intent(out) :: info          !! SHAPE_OK, SHAPE_TOO_MANY_NODES, SHAPE_SUPPORT_CLIPPED
-    integer :: nd, k1, k2, k3, a, ijk(3)
+    integer :: nd, k1, k2, k3, a, d, row, n1, n12
     real(wp) :: w23, w13, w12
     nd = grid%ndim
     nn = 0
-    a = product(m)
+    a = m(1) * m(2) * m(3)
     if (a > size(node) .or. a > size(N) .or. a > size(dN, 2) .or. size(dN, 1) < nd) then
       info = SHAPE_TOO_MANY_NODES; return
     end if
+    ! Families only hand over nodes inside the grid; guard against a logic error once per
+    ! direction (a node_id call per node cost as much as the products).
+    do d = 1, 3
+      if (base(d) < 0 .or. base(d) + m(d) - 1 >= grid%nn(d)) then
+        info = SHAPE_SUPPORT_CLIPPED; return
+      end if
+    end do
+    n1 = grid%nn(1); n12 = grid%nn(1) * grid%nn(2)
     a = 0
     do k3 = 1, m(3)
       do k2 = 1, m(2)
         w23 = w(k2, 2) * w(k3, 3)
+        ! grid%node_id of (base(1), base(2) + k2 − 1, base(3) + k3 − 1), the row's first node
+        row = 1 + base(1) + n1 * (base(2) + k2 - 1) + n12 * (base(3) + k3 - 1)
         do k1 = 1, m(1)
           a = a + 1
-          ijk = base + [k1, k2, k3] - 1
-          node(a) = grid%node_id(ijk)
-          ! Families only hand over nodes inside the grid; guard against a logic error.
-          if (node(a) == 0) then
-            info = SHAPE_SUPPORT_CLIPPED; return
-          end if
+          node(a) = row + k1 - 1
           N(a) = w(k1, 1) * w23
           dN(1, a) = g(k1, 1) * w23
           if (nd >= 2) then
