@@ -145,9 +145,9 @@ contains
     integer :: p, pinfo
     call shape_batch_fits(pts%np, basis, ibad, info)
     if (info /= SHAPE_OK) return
-    if (self%order == 2 .and. .not. self%clamped .and. grid%ndim == 2 .and. basis%maxn >= 9 &
-        .and. size(basis%dN, 1) >= 2) then
-      call quadratic_2d_batch(grid, pts, basis, ibad, info)
+    if (.not. self%clamped .and. grid%ndim >= 2 .and. &
+        basis%maxn >= (self%order + 1)**grid%ndim .and. size(basis%dN, 1) >= grid%ndim) then
+      call uniform_batch(self%order, grid, pts, basis, ibad, info)
       return
     end if
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
@@ -163,53 +163,85 @@ contains
     if (ibad == huge(1)) ibad = 0
   end subroutine bspline_eval_batch
 
-  !> The uniform quadratic B-splines in 2D for particles 1..pts%np, the hot case written out:
-  !> the arithmetic of [[shape_bspline_kernel]] (bspline_1d and shape_tp_assemble: the same
-  !> values, bitwise, and the same node lists, a node with a zero value dropped), without its
-  !> per-particle calls, work arrays and per-node index checks (they were ~40 % of a bspline2
-  !> step). `tests/unit/test_bspline_fast.pf` compares the two.
-  subroutine quadratic_2d_batch(grid, pts, basis, ibad, info)
-    type(empm_grid_t), intent(in) :: grid           !! background grid (2D)
+  !> The uniform B-splines (quadratic, cubic) in 2D and 3D for particles 1..pts%np, the hot
+  !> case written out: the arithmetic of [[shape_bspline_kernel]] (bspline_1d and
+  !> shape_tp_assemble: the same values, bitwise, and the same node lists, a node with a zero
+  !> value dropped), without its per-particle calls, work arrays and per-node index checks
+  !> (they were ~40 % of a 2D bspline2 step). `tests/unit/test_bspline_fast.pf` compares them.
+  subroutine uniform_batch(order, grid, pts, basis, ibad, info)
+    integer, intent(in) :: order                    !! 2 or 3
+    type(empm_grid_t), intent(in) :: grid           !! background grid (2D or 3D)
     type(empm_particles_t), intent(in) :: pts       !! particles
-    type(empm_basis_t), intent(inout) :: basis      !! node lists (maxn >= 9)
+    type(empm_basis_t), intent(inout) :: basis      !! node lists (maxn >= (order + 1)^ndim)
     integer, intent(out) :: ibad                    !! first failing particle, 0 if none
     integer, intent(out) :: info                    !! SHAPE_OK or the failing particle's code
-    real(wp) :: o(2), e(2), ih(2), w(3, 2), g(3, 2)
-    integer :: p, pinfo, m(2), base(2), n1, c(2), k1, k2, a, row
-    o = grid%origin(1:2); ih = grid%inv_h(1:2); c = grid%ncell(1:2)
-    e = grid%origin(1:2) + grid%ncell(1:2) * grid%h(1:2)
-    n1 = grid%nn(1)
+    real(wp) :: o(3), e(3), ih(3), w(4, 3), g(4, 3), w23, w13
+    integer :: p, pinfo, m(3), base(3), n1, n12, c(3), k1, k2, k3, a, row, nd, d
+    logical :: inside
+    nd = grid%ndim
+    o = grid%origin; ih = grid%inv_h; c = grid%ncell
+    e = grid%origin + grid%ncell * grid%h
+    n1 = grid%nn(1); n12 = grid%nn(1) * grid%nn(2)
     ibad = huge(1); info = SHAPE_OK
     !$omp parallel do default(none) schedule(static) &
-    !$omp   shared(pts, basis, ibad, info, o, e, ih, c, n1) &
-    !$omp   private(pinfo, m, base, w, g, k1, k2, a, row) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
+    !$omp   shared(order, pts, basis, ibad, info, o, e, ih, c, n1, n12, nd) &
+    !$omp   private(pinfo, m, base, w, g, k1, k2, k3, a, row, d, inside, w23, w13) &
+    !$omp   if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
       ! grid%inside
-      if (.not. (pts%x(1, p) >= o(1) .and. pts%x(1, p) <= e(1) .and. &
-                 pts%x(2, p) >= o(2) .and. pts%x(2, p) <= e(2))) then
+      inside = .true.
+      do d = 1, nd
+        if (.not. (pts%x(d, p) >= o(d) .and. pts%x(d, p) <= e(d))) inside = .false.
+      end do
+      if (.not. inside) then
         basis%nn(p) = 0
         call shape_keep_first_failure(p, SHAPE_OUTSIDE_GRID, ibad, info); cycle
       end if
-      call factors(pts%x(1, p), o(1), ih(1), c(1), m(1), base(1), w(:, 1), g(:, 1), pinfo)
-      if (pinfo == SHAPE_OK) &
-        call factors(pts%x(2, p), o(2), ih(2), c(2), m(2), base(2), w(:, 2), g(:, 2), pinfo)
+      ! Beyond ndim: one node at index 0 with factor 1 (shape_tp_init).
+      m(3) = 1; base(3) = 0; w(1, 3) = 1.0_wp; g(1, 3) = 0.0_wp
+      pinfo = SHAPE_OK
+      do d = 1, nd
+        if (order == 2) then
+          call factors2(pts%x(d, p), o(d), ih(d), c(d), m(d), base(d), w(:, d), g(:, d), pinfo)
+        else
+          call factors3(pts%x(d, p), o(d), ih(d), c(d), m(d), base(d), w(:, d), g(:, d), pinfo)
+        end if
+        if (pinfo /= SHAPE_OK) exit
+      end do
       if (pinfo /= SHAPE_OK) then
         basis%nn(p) = 0
         call shape_keep_first_failure(p, pinfo, ibad, info); cycle
       end if
-      ! shape_tp_assemble with m(3) = 1, w(1, 3) = 1 and g(1, 3) = 0: w23 = w(k2, 2) · 1 and
-      ! w13 = w(k1, 1) · 1 exactly.
       a = 0
-      do k2 = 1, m(2)
-        row = 1 + base(1) + n1 * (base(2) + k2 - 1)
-        do k1 = 1, m(1)
-          a = a + 1
-          basis%node(a, p) = row + k1 - 1
-          basis%N(a, p) = w(k1, 1) * w(k2, 2)
-          basis%dN(1, a, p) = g(k1, 1) * w(k2, 2)
-          basis%dN(2, a, p) = g(k2, 2) * w(k1, 1)
+      if (nd == 2) then
+        ! w(k3, 3) = 1: w23 = w(k2, 2) and w13 = w(k1, 1) exactly.
+        do k2 = 1, m(2)
+          row = 1 + base(1) + n1 * (base(2) + k2 - 1)
+          do k1 = 1, m(1)
+            a = a + 1
+            basis%node(a, p) = row + k1 - 1
+            basis%N(a, p) = w(k1, 1) * w(k2, 2)
+            basis%dN(1, a, p) = g(k1, 1) * w(k2, 2)
+            basis%dN(2, a, p) = g(k2, 2) * w(k1, 1)
+          end do
         end do
-      end do
+      else
+        do k3 = 1, m(3)
+          do k2 = 1, m(2)
+            w23 = w(k2, 2) * w(k3, 3)
+            row = 1 + base(1) + n1 * (base(2) + k2 - 1) + n12 * (base(3) + k3 - 1)
+            do k1 = 1, m(1)
+              a = a + 1
+              basis%node(a, p) = row + k1 - 1
+              basis%N(a, p) = w(k1, 1) * w23
+              basis%dN(1, a, p) = g(k1, 1) * w23
+              w13 = w(k1, 1) * w(k3, 3)
+              basis%dN(2, a, p) = g(k2, 2) * w13
+              basis%dN(3, a, p) = g(k3, 3) * (w(k1, 1) * w(k2, 2))
+            end do
+          end do
+        end do
+      end if
       basis%nn(p) = a
     end do
     !$omp end parallel do
@@ -217,12 +249,14 @@ contains
 
   contains
 
-    ! bspline_1d for order 2 along one direction (s in cell units from the origin).
-    pure subroutine factors(xd, od, ihd, ncell, m, base, w, g, info)
+    ! bspline_1d of order 2 along one direction (s in cell units from the origin), the same
+    ! expressions; factors3 the same for order 3 (the order fixed: the loop and the branches
+    ! then compile to straight code).
+    pure subroutine factors2(xd, od, ihd, ncell, m, base, w, g, info)
       real(wp), intent(in) :: xd, od, ihd
       integer, intent(in) :: ncell
       integer, intent(out) :: m, base
-      real(wp), intent(out) :: w(3), g(3)
+      real(wp), intent(inout) :: w(4), g(4)
       integer, intent(out) :: info
       real(wp) :: s, u, r
       integer :: i, i1
@@ -250,8 +284,42 @@ contains
         end if
       end do
       info = SHAPE_OK
-    end subroutine factors
-  end subroutine quadratic_2d_batch
+    end subroutine factors2
+
+    pure subroutine factors3(xd, od, ihd, ncell, m, base, w, g, info)
+      real(wp), intent(in) :: xd, od, ihd
+      integer, intent(in) :: ncell
+      integer, intent(out) :: m, base
+      real(wp), intent(inout) :: w(4), g(4)
+      integer, intent(out) :: info
+      real(wp) :: s, u, r
+      integer :: i, i1
+      m = 0; base = 0
+      s = (xd - od) * ihd
+      i1 = floor(s - 1.0_wp)
+      do i = i1, i1 + 3
+        u = s - i
+        r = abs(u)
+        if (r >= 2.0_wp) cycle
+        if (i < 0 .or. i > ncell) then
+          if (r < 2.0_wp - SHAPE_CLIP_TOL) then
+            info = SHAPE_SUPPORT_CLIPPED; return
+          end if
+          cycle
+        end if
+        if (m == 0) base = i
+        m = m + 1
+        if (r < 1.0_wp) then
+          w(m) = 2.0_wp / 3.0_wp - r * r + 0.5_wp * r**3
+          g(m) = u * (1.5_wp * r - 2.0_wp) * ihd
+        else
+          w(m) = (2.0_wp - r)**3 / 6.0_wp
+          g(m) = -sign(1.0_wp, u) * 0.5_wp * (2.0_wp - r)**2 * ihd
+        end if
+      end do
+      info = SHAPE_OK
+    end subroutine factors3
+  end subroutine uniform_batch
 
   !> B-spline shape functions of degree `order` at one point; only nodes with a nonzero value
   !> are returned, in increasing index order.
