@@ -193,6 +193,7 @@ def main():
     md += materials_section(Path(sys.argv[1]).with_name("materials.jsonl"), rev)
     md += run_path_section(Path(sys.argv[1]).with_name("runpath.jsonl"))
     md += threads_section(Path(sys.argv[1]).with_name("threads.jsonl"))
+    md += peers_section(Path(sys.argv[1]).with_name("peers.jsonl"))
     (out / "performance.md").write_text("\n".join(md))
     print(f"wrote {out / 'performance.md'} and {out / 'performance.png'}")
 
@@ -311,6 +312,42 @@ def threads_section(path):
             if load == "busy" else ("", "")
         md.append(f"| {load} | {cell['default']} | {cell['1']} | {cell['2']} | {rmed:.2f} "
                   f"({min(ratios):.2f}–{max(ratios):.2f}) | {target} | {met} |")
+    md.append("")
+    return md
+
+
+def peers_section(path):
+    """Taichi's MLS-MPM script against empm's bspline2 (issue 17, item 3), each pair measured
+    back to back: the ratio per round, its median and range."""
+    if not path.exists():
+        return []
+    peer, ours = {}, {}
+    with open(path) as f:
+        for line in f:
+            d = json.loads(line)
+            r = d["run"]
+            key = (r["particles"], r["threads"], d["round"])
+            (peer if d["tag"] == "peer" else ours)[key] = r
+    md = ["## Peers: Taichi MLS-MPM against `bspline2` (issue 17, item 3)", "",
+          "`benchmarks/run --peers`: `benchmarks/peers/taichi_mpm88.py` (mpm88-style MLS-MPM: "
+          "quadratic B-splines, APIC, float64, Taichi's CPU backend, the bench's block with "
+          "mpm88's one-scalar fluid stress) and `empm bench --shape bspline2` (pc_newmark: two "
+          "P2G passes, full stress, strain and F) on the same block, back to back, three rounds. "
+          "Ratio: empm / Taichi particle-steps/s per round, median (range).", "",
+          "| particles | threads | Taichi | empm bspline2 | ratio | target | met |",
+          "|---|---|---|---|---|---|---|"]
+    for (np_, th) in sorted({(k[0], k[1]) for k in peer}):
+        keys = [k for k in peer if k[:2] == (np_, th) and k in ours]
+        if not keys:
+            continue
+        tp = [peer[k]["particle_steps_per_second"] for k in keys]
+        ep = [ours[k]["particle_steps_per_second"] for k in keys]
+        ratios = [ours[k]["particle_steps_per_second"] / peer[k]["particle_steps_per_second"]
+                  for k in keys]
+        rmed = statistics.median(ratios)
+        md.append(f"| {np_} | {th} | {fmt(statistics.median(tp))} | {fmt(statistics.median(ep))} "
+                  f"| {rmed:.2f} ({min(ratios):.2f}–{max(ratios):.2f}) | ≥ 1.5 | "
+                  f"{'yes' if rmed >= 1.5 else '**no**'} |")
     md.append("")
     return md
 
