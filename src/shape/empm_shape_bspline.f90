@@ -33,7 +33,7 @@ module empm_shape_bspline
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES
   use empm_shape_linear, only: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, &
-                               shape_batch_fits, shape_keep_first_failure
+                               shape_batch_fits, shape_keep_first_failure, shape_tp_store
   implicit none
   private
   public :: empm_shape_bspline_t, shape_bspline_kernel
@@ -175,17 +175,16 @@ contains
     type(empm_basis_t), intent(inout) :: basis      !! node lists (maxn >= (order + 1)^ndim)
     integer, intent(out) :: ibad                    !! first failing particle, 0 if none
     integer, intent(out) :: info                    !! SHAPE_OK or the failing particle's code
-    real(wp) :: o(3), e(3), ih(3), w(4, 3), g(4, 3), w23, w13
-    integer :: p, pinfo, m(3), base(3), n1, n12, c(3), k1, k2, k3, a, row, nd, d
+    real(wp) :: o(3), e(3), ih(3), w(4, 3), g(4, 3)
+    integer :: p, pinfo, m(3), base(3), c(3), nd, d
     logical :: inside
     nd = grid%ndim
     o = grid%origin; ih = grid%inv_h; c = grid%ncell
     e = grid%origin + grid%ncell * grid%h
-    n1 = grid%nn(1); n12 = grid%nn(1) * grid%nn(2)
     ibad = huge(1); info = SHAPE_OK
     !$omp parallel do default(none) schedule(static) &
-    !$omp   shared(order, pts, basis, ibad, info, o, e, ih, c, n1, n12, nd) &
-    !$omp   private(pinfo, m, base, w, g, k1, k2, k3, a, row, d, inside, w23, w13) &
+    !$omp   shared(order, grid, pts, basis, ibad, info, o, e, ih, c, nd) &
+    !$omp   private(pinfo, m, base, w, g, d, inside) &
     !$omp   if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
       ! grid%inside
@@ -212,37 +211,8 @@ contains
         basis%nn(p) = 0
         call shape_keep_first_failure(p, pinfo, ibad, info); cycle
       end if
-      a = 0
-      if (nd == 2) then
-        ! w(k3, 3) = 1: w23 = w(k2, 2) and w13 = w(k1, 1) exactly.
-        do k2 = 1, m(2)
-          row = 1 + base(1) + n1 * (base(2) + k2 - 1)
-          do k1 = 1, m(1)
-            a = a + 1
-            basis%node(a, p) = row + k1 - 1
-            basis%N(a, p) = w(k1, 1) * w(k2, 2)
-            basis%dN(1, a, p) = g(k1, 1) * w(k2, 2)
-            basis%dN(2, a, p) = g(k2, 2) * w(k1, 1)
-          end do
-        end do
-      else
-        do k3 = 1, m(3)
-          do k2 = 1, m(2)
-            w23 = w(k2, 2) * w(k3, 3)
-            row = 1 + base(1) + n1 * (base(2) + k2 - 1) + n12 * (base(3) + k3 - 1)
-            do k1 = 1, m(1)
-              a = a + 1
-              basis%node(a, p) = row + k1 - 1
-              basis%N(a, p) = w(k1, 1) * w23
-              basis%dN(1, a, p) = g(k1, 1) * w23
-              w13 = w(k1, 1) * w(k3, 3)
-              basis%dN(2, a, p) = g(k2, 2) * w13
-              basis%dN(3, a, p) = g(k3, 3) * (w(k1, 1) * w(k2, 2))
-            end do
-          end do
-        end do
-      end if
-      basis%nn(p) = a
+      call shape_tp_store(grid, m, base, w, g, basis, p, pinfo)
+      if (pinfo /= SHAPE_OK) call shape_keep_first_failure(p, pinfo, ibad, info)
     end do
     !$omp end parallel do
     if (ibad == huge(1)) ibad = 0

@@ -18,7 +18,7 @@ module empm_shape_linear
   private
   public :: empm_shape_linear_t, shape_linear_kernel
   public :: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, shape_batch_fits
-  public :: shape_keep_first_failure
+  public :: shape_keep_first_failure, shape_tp_store
 
   !> Most nodes per direction of any tensor-product family (cubic B-spline).
   integer, parameter :: SHAPE_TP_MAXM = 4
@@ -343,6 +343,61 @@ contains
     nn = a
     info = SHAPE_OK
   end subroutine shape_tp_assemble
+
+  !> [[shape_tp_assemble]] for a batch in 2D or 3D: the tensor product of the 1D factors
+  !> straight into particle p's node list (the same products, bitwise; `w(1, 3) = 1` and
+  !> `g(1, 3) = 0` with `m(3) = 1`, `base(3) = 0` in 2D). The families' batch loops call it
+  !> instead of the per-point kernel: no array sections, work arrays or per-node index
+  !> checks. `info` = SHAPE_TOO_MANY_NODES when the node list has no room (nothing written).
+  pure subroutine shape_tp_store(grid, m, base, w, g, basis, p, info)
+    type(empm_grid_t), intent(in) :: grid       !! background grid (2D or 3D)
+    integer, intent(in) :: m(3)                 !! nodes per direction (1 beyond ndim)
+    integer, intent(in) :: base(3)              !! 0-based index of the first node per direction
+    real(wp), intent(in) :: w(:,:)              !! 1D values (>= max m, 3)
+    real(wp), intent(in) :: g(:,:)              !! 1D derivatives with respect to x_d
+    type(empm_basis_t), intent(inout) :: basis  !! node lists
+    integer, intent(in) :: p                    !! particle
+    integer, intent(out) :: info                !! SHAPE_OK or SHAPE_TOO_MANY_NODES
+    integer :: a, k1, k2, k3, row, n1, n12
+    real(wp) :: w23, w13
+    if (m(1) * m(2) * m(3) > basis%maxn) then
+      basis%nn(p) = 0
+      info = SHAPE_TOO_MANY_NODES; return
+    end if
+    n1 = grid%nn(1); n12 = grid%nn(1) * grid%nn(2)
+    a = 0
+    if (grid%ndim == 2) then
+      ! w(k3, 3) = 1: w23 = w(k2, 2) and w13 = w(k1, 1) exactly.
+      do k2 = 1, m(2)
+        row = 1 + base(1) + n1 * (base(2) + k2 - 1)
+        do k1 = 1, m(1)
+          a = a + 1
+          basis%node(a, p) = row + k1 - 1
+          basis%N(a, p) = w(k1, 1) * w(k2, 2)
+          basis%dN(1, a, p) = g(k1, 1) * w(k2, 2)
+          basis%dN(2, a, p) = g(k2, 2) * w(k1, 1)
+        end do
+      end do
+    else
+      do k3 = 1, m(3)
+        do k2 = 1, m(2)
+          w23 = w(k2, 2) * w(k3, 3)
+          row = 1 + base(1) + n1 * (base(2) + k2 - 1) + n12 * (base(3) + k3 - 1)
+          do k1 = 1, m(1)
+            a = a + 1
+            basis%node(a, p) = row + k1 - 1
+            basis%N(a, p) = w(k1, 1) * w23
+            basis%dN(1, a, p) = g(k1, 1) * w23
+            w13 = w(k1, 1) * w(k3, 3)
+            basis%dN(2, a, p) = g(k2, 2) * w13
+            basis%dN(3, a, p) = g(k3, 3) * (w(k1, 1) * w(k2, 2))
+          end do
+        end do
+      end do
+    end if
+    basis%nn(p) = a
+    info = SHAPE_OK
+  end subroutine shape_tp_store
 
   !> Check that `basis` has storage for `np` particles before a batch (the per-particle
   !> capacity and dimension are checked by [[shape_tp_assemble]]) in a layout the caller

@@ -27,7 +27,7 @@ module empm_shape_ugimp
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES
   use empm_shape_linear, only: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, &
-                               shape_batch_fits, shape_keep_first_failure
+                               shape_batch_fits, shape_keep_first_failure, shape_tp_store
   implicit none
   private
   public :: empm_shape_ugimp_t, shape_ugimp_kernel
@@ -114,19 +114,47 @@ contains
     integer, intent(out) :: ibad                  !! first failing particle, 0 if none
     integer, intent(out) :: info                  !! SHAPE_OK or the failing particle's code
     integer :: p, pinfo
+    real(wp) :: w(3, 3), g(3, 3)
+    integer :: m(3), base(3), d
     associate (unused_ => self); end associate
     call shape_batch_fits(pts%np, basis, ibad, info)
     if (info /= SHAPE_OK) return
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
-    !$omp parallel do default(none) schedule(static) shared(grid, pts, basis, ibad, info) &
-    !$omp   private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
-    do p = 1, pts%np
-      call shape_ugimp_kernel(grid, pts%x(:, p), pts%lp(:, p), basis%nn(p), basis%node(:, p), &
-                              basis%N(:, p), basis%dN(:, :, p), pinfo)
-      if (pinfo /= SHAPE_OK) call shape_keep_first_failure(p, pinfo, ibad, info)
-    end do
-    !$omp end parallel do
+    if (grid%ndim >= 2 .and. size(basis%dN, 1) >= grid%ndim) then
+      ! The kernel's steps written out (the same arithmetic, bitwise: test_bspline_fast):
+      ! no per-particle call, work arrays or per-node index checks.
+      !$omp parallel do default(none) schedule(static) shared(grid, pts, basis, ibad, info) &
+      !$omp   private(pinfo, m, base, w, g, d) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
+      do p = 1, pts%np
+        if (.not. grid%inside(pts%x(:, p))) then
+          basis%nn(p) = 0
+          call shape_keep_first_failure(p, SHAPE_OUTSIDE_GRID, ibad, info); cycle
+        end if
+        m(3) = 1; base(3) = 0; w(1, 3) = 1.0_wp; g(1, 3) = 0.0_wp
+        pinfo = SHAPE_OK
+        do d = 1, grid%ndim
+          call ugimp_1d(grid, d, pts%x(d, p), pts%lp(d, p), m(d), base(d), w(:, d), g(:, d), &
+                        pinfo)
+          if (pinfo /= SHAPE_OK) exit
+        end do
+        if (pinfo == SHAPE_OK) call shape_tp_store(grid, m, base, w, g, basis, p, pinfo)
+        if (pinfo /= SHAPE_OK) then
+          basis%nn(p) = 0
+          call shape_keep_first_failure(p, pinfo, ibad, info)
+        end if
+      end do
+      !$omp end parallel do
+    else
+      !$omp parallel do default(none) schedule(static) shared(grid, pts, basis, ibad, info) &
+      !$omp   private(pinfo) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
+      do p = 1, pts%np
+        call shape_ugimp_kernel(grid, pts%x(:, p), pts%lp(:, p), basis%nn(p), &
+                                basis%node(:, p), basis%N(:, p), basis%dN(:, :, p), pinfo)
+        if (pinfo /= SHAPE_OK) call shape_keep_first_failure(p, pinfo, ibad, info)
+      end do
+      !$omp end parallel do
+    end if
     if (ibad == huge(1)) ibad = 0
   end subroutine ugimp_eval_batch
 
