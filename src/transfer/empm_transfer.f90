@@ -30,6 +30,7 @@ module empm_transfer
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_transfer_2d, only: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, &
                               g2p_2d
+  use empm_transfer_3d, only: internal_force_3d, velocity_gradient_3d, g2p_3d
   use empm_transfer_q4, only: mass_q4, weighted_q4, mass_momentum_q4, body_force_q4, &
                               internal_force_q4, velocity_gradient_q4, g2p_q4
   implicit none
@@ -441,6 +442,10 @@ contains
       call internal_force_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%dN, vol, stress, f)
       return
     end if
+    if (d == 3) then
+      call internal_force_3d(basis%maxn, p0, p1, basis%nn, basis%node, basis%dN, vol, stress, f)
+      return
+    end if
     do p = p0, p1
       s(1, 1) = stress(1, p); s(2, 2) = stress(2, p); s(3, 3) = stress(3, p)
       s(2, 3) = stress(4, p); s(3, 2) = stress(4, p)
@@ -507,6 +512,10 @@ contains
         call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .false., 0.0_wp, u)
         cycle
       end if
+      if (basis%ndim == 3) then
+        call g2p_3d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .false., 0.0_wp, u)
+        cycle
+      end if
       do p = p0, p1
         u(:, p) = 0.0_wp
         do k = 1, basis%nn(p)
@@ -537,6 +546,10 @@ contains
     end if
     if (d == 2) then
       call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .true., c, u)
+      return
+    end if
+    if (d == 3) then
+      call g2p_3d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .true., c, u)
       return
     end if
     do p = p0, p1
@@ -587,6 +600,11 @@ contains
     if (d == 2) then
       ! Element sequence association: the kernel sees particles p0..p1 as 1..p1-p0+1.
       call velocity_gradient_2d(basis%maxn, 1, p1 - p0 + 1, basis%nn(p0), basis%node(1, p0), &
+                                basis%dN(1, 1, p0), v, L)
+      return
+    end if
+    if (d == 3) then
+      call velocity_gradient_3d(basis%maxn, 1, p1 - p0 + 1, basis%nn(p0), basis%node(1, p0), &
                                 basis%dN(1, 1, p0), v, L)
       return
     end if
