@@ -175,24 +175,15 @@ contains
     type(empm_basis_t), intent(inout) :: basis      !! node lists (maxn >= (order + 1)^ndim)
     integer, intent(out) :: ibad                    !! first failing particle, 0 if none
     integer, intent(out) :: info                    !! SHAPE_OK or the failing particle's code
-    real(wp) :: o(3), e(3), ih(3), w(4, 3), g(4, 3)
-    integer :: p, pinfo, m(3), base(3), c(3), nd, d
-    logical :: inside
+    real(wp) :: w(4, 3), g(4, 3)
+    integer :: p, pinfo, m(3), base(3), nd, d
     nd = grid%ndim
-    o = grid%origin; ih = grid%inv_h; c = grid%ncell
-    e = grid%origin + grid%ncell * grid%h
     ibad = huge(1); info = SHAPE_OK
     !$omp parallel do default(none) schedule(static) &
-    !$omp   shared(order, grid, pts, basis, ibad, info, o, e, ih, c, nd) &
-    !$omp   private(pinfo, m, base, w, g, d, inside) &
+    !$omp   shared(order, grid, pts, basis, ibad, info, nd) private(pinfo, m, base, w, g, d) &
     !$omp   if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
-      ! grid%inside
-      inside = .true.
-      do d = 1, nd
-        if (.not. (pts%x(d, p) >= o(d) .and. pts%x(d, p) <= e(d))) inside = .false.
-      end do
-      if (.not. inside) then
+      if (.not. grid%inside(pts%x(:, p))) then
         basis%nn(p) = 0
         call shape_keep_first_failure(p, SHAPE_OUTSIDE_GRID, ibad, info); cycle
       end if
@@ -200,11 +191,7 @@ contains
       m(3) = 1; base(3) = 0; w(1, 3) = 1.0_wp; g(1, 3) = 0.0_wp
       pinfo = SHAPE_OK
       do d = 1, nd
-        if (order == 2) then
-          call factors2(pts%x(d, p), o(d), ih(d), c(d), m(d), base(d), w(:, d), g(:, d), pinfo)
-        else
-          call factors3(pts%x(d, p), o(d), ih(d), c(d), m(d), base(d), w(:, d), g(:, d), pinfo)
-        end if
+        call bspline_1d(order, grid, d, pts%x(d, p), m(d), base(d), w(:, d), g(:, d), pinfo)
         if (pinfo /= SHAPE_OK) exit
       end do
       if (pinfo /= SHAPE_OK) then
@@ -216,79 +203,6 @@ contains
     end do
     !$omp end parallel do
     if (ibad == huge(1)) ibad = 0
-
-  contains
-
-    ! bspline_1d of order 2 along one direction (s in cell units from the origin), the same
-    ! expressions; factors3 the same for order 3 (the order fixed: the loop and the branches
-    ! then compile to straight code).
-    pure subroutine factors2(xd, od, ihd, ncell, m, base, w, g, info)
-      real(wp), intent(in) :: xd, od, ihd
-      integer, intent(in) :: ncell
-      integer, intent(out) :: m, base
-      real(wp), intent(inout) :: w(4), g(4)
-      integer, intent(out) :: info
-      real(wp) :: s, u, r
-      integer :: i, i1
-      m = 0; base = 0
-      s = (xd - od) * ihd
-      i1 = floor(s - 0.5_wp)
-      do i = i1, i1 + 2
-        u = s - i
-        r = abs(u)
-        if (r >= 1.5_wp) cycle
-        if (i < 0 .or. i > ncell) then
-          if (r < 1.5_wp - SHAPE_CLIP_TOL) then
-            info = SHAPE_SUPPORT_CLIPPED; return
-          end if
-          cycle
-        end if
-        if (m == 0) base = i
-        m = m + 1
-        if (r < 0.5_wp) then
-          w(m) = 0.75_wp - r * r
-          g(m) = -2.0_wp * u * ihd
-        else
-          w(m) = 0.5_wp * (1.5_wp - r)**2
-          g(m) = -sign(1.0_wp, u) * (1.5_wp - r) * ihd
-        end if
-      end do
-      info = SHAPE_OK
-    end subroutine factors2
-
-    pure subroutine factors3(xd, od, ihd, ncell, m, base, w, g, info)
-      real(wp), intent(in) :: xd, od, ihd
-      integer, intent(in) :: ncell
-      integer, intent(out) :: m, base
-      real(wp), intent(inout) :: w(4), g(4)
-      integer, intent(out) :: info
-      real(wp) :: s, u, r
-      integer :: i, i1
-      m = 0; base = 0
-      s = (xd - od) * ihd
-      i1 = floor(s - 1.0_wp)
-      do i = i1, i1 + 3
-        u = s - i
-        r = abs(u)
-        if (r >= 2.0_wp) cycle
-        if (i < 0 .or. i > ncell) then
-          if (r < 2.0_wp - SHAPE_CLIP_TOL) then
-            info = SHAPE_SUPPORT_CLIPPED; return
-          end if
-          cycle
-        end if
-        if (m == 0) base = i
-        m = m + 1
-        if (r < 1.0_wp) then
-          w(m) = 2.0_wp / 3.0_wp - r * r + 0.5_wp * r**3
-          g(m) = u * (1.5_wp * r - 2.0_wp) * ihd
-        else
-          w(m) = (2.0_wp - r)**3 / 6.0_wp
-          g(m) = -sign(1.0_wp, u) * 0.5_wp * (2.0_wp - r)**2 * ihd
-        end if
-      end do
-      info = SHAPE_OK
-    end subroutine factors3
   end subroutine uniform_batch
 
   !> B-spline shape functions of degree `order` at one point; only nodes with a nonzero value
