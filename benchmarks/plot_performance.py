@@ -52,7 +52,13 @@ def main():
     rows = load(sys.argv[1])
     out = Path(sys.argv[2])
     matrix = [r for r in rows if r["tag"] == "matrix"]
-    sweep = [r for r in rows if r["tag"] == "sweep"]
+    # The sweep's rounds: the median run of each (shape, size).
+    by_size = {}
+    for r in rows:
+        if r["tag"] == "sweep":
+            by_size.setdefault((r["shape"], r["particles"]), []).append(r)
+    sweep = [sorted(rs, key=lambda r: r["particle_steps_per_second"])[len(rs) // 2]
+             for rs in by_size.values()]
     speed = [r for r in rows if r["tag"] == "speedup"]
     grind = [r for r in rows if r["tag"] == "callgrind"]
     bw = [r for r in rows if r["tag"] == "bandwidth"]
@@ -144,7 +150,8 @@ def main():
                   f'{fmt(r["particle_steps_per_second"])} | {r["bytes_per_particle"]:.0f} |')
     if sweep:
         md += ["", "Flatness (issue 17, item 5): the cost per particle-step at the largest size "
-               "against the smallest, and the spread (slowest against fastest) over the sizes.", "",
+               "against the smallest, and the spread (slowest against fastest) over the sizes; "
+               "each size is the median of three rounds.", "",
                "| shape | sizes | 1e6 / 1e4 cost | max / min cost |", "|---|---|---|---|"]
         for shape in sorted({r["shape"] for r in sweep}):
             pts = sorted((r["particles"], r["particle_steps_per_second"]) for r in sweep
