@@ -32,12 +32,12 @@ program energy_histories
   integer, parameter :: NS = 9
   integer, parameter :: CASE_BAR = 1, CASE_DISKS = 2
   character(len=16), parameter :: SCHEME(NS) = [character(len=16) :: 'usf', 'usl', 'musl', &
-    'pc_published', 'pc_newmark', 'gen_alpha', 'gen_alpha', 'gen_alpha', 'gen_alpha']
+    'pc_published', 'pc_newmark', 'gen_alpha_grid', 'gen_alpha_grid', 'gen_alpha_grid', 'gen_alpha_grid']
   real(wp), parameter :: RHO_B(NS) = [0.8_wp, 0.8_wp, 0.8_wp, 0.8_wp, 0.8_wp, 0.0_wp, 0.5_wp, &
                                       0.8_wp, 1.0_wp]
   character(len=16), parameter :: LABEL(NS) = [character(len=16) :: 'usf', 'usl', 'musl', &
-    'pc_published', 'pc_newmark', 'gen_alpha_rb0.0', 'gen_alpha_rb0.5', 'gen_alpha_rb0.8', &
-    'gen_alpha_rb1.0']
+    'pc_published', 'pc_newmark', 'gen_alpha_grid_rb0.0', 'gen_alpha_grid_rb0.5', 'gen_alpha_grid_rb0.8', &
+    'gen_alpha_grid_rb1.0']
   character(len=:), allocatable :: outdir
   character(len=512) :: buf
   integer(hid_t) :: fid
@@ -111,9 +111,9 @@ contains
     else
       call build_disks(model, cfg, cfl)
     end if
-    ! ρ_b is gen_alpha's parameter; the other schemes declare none (an undeclared key is an
-    ! error), so it is passed to gen_alpha only.
-    if (trim(SCHEME(i)) == 'gen_alpha') then
+    ! ρ_b is gen_alpha_grid's parameter; the other schemes declare none (an undeclared key is an
+    ! error), so it is passed to gen_alpha_grid only.
+    if (trim(SCHEME(i)) == 'gen_alpha_grid') then
       call empm_create_integrator(trim(SCHEME(i)), integ, err, empm_kv('rho_b', RHO_B(i)))
     else
       call empm_create_integrator(trim(SCHEME(i)), integ, err)

@@ -3,7 +3,7 @@
 !> - on the one-cell oscillator (particle at the cell centre; Ω = ωΔt = CFL, ω = c/h): the
 !>   spectral radius ρ, the numerical damping ratio ξ̄ and the relative period error
 !>   (T̄ − T)/T over Ω ∈ (0, 2.5], and the critical Ω; the same with the particle on the node
-!>   (the nodal scheme itself; for gen_alpha the Hulbert–Chung scheme);
+!>   (the nodal scheme itself; for gen_alpha_grid the Hulbert–Chung scheme);
 !> - on the fixed-free 20-cell lattice with 1 and 2 particles per cell: the critical CFL from
 !>   the lattice amplification matrix, and from direct runs (real steps from small random
 !>   velocities, CFL raised by 0.01 until the energy grows by 1e4 within 2000 steps).
@@ -25,7 +25,7 @@ program stability_curves
   real(wp), parameter :: OMAX = 2.5_wp, GROWTH = 1.0e4_wp
   type(empm_scheme_spec_t) :: sp(NS)
   ! ρ_b and γ_N of each scheme, as recorded in stability.h5 (the defaults where the scheme has
-  ! no such parameter); only gen_alpha gets rho_b in its spec (an undeclared key is an error).
+  ! no such parameter); only gen_alpha_grid gets rho_b in its spec (an undeclared key is an error).
   real(wp) :: rho_b(NS) = 0.8_wp, newmark_gamma(NS) = 0.5_wp
   character(len=24) :: label(NS)
   type(empm_root_t) :: roots(NOM)
@@ -46,14 +46,14 @@ program stability_curves
   sp(4)%name = 'pc_published'; sp(5)%name = 'pc_newmark'
   label(1:5) = sp(1:5)%name
   do i = 6, 9
-    sp(i)%name = 'gen_alpha'
+    sp(i)%name = 'gen_alpha_grid'
   end do
   rho_b(6:9) = [0.0_wp, 0.5_wp, 0.8_wp, 1.0_wp]
   do i = 6, 9
     sp(i)%params = empm_kv('rho_b', rho_b(i))
   end do
-  label(6:9) = [character(len=24) :: 'gen_alpha_rb0.0', 'gen_alpha_rb0.5', 'gen_alpha_rb0.8', &
-                'gen_alpha_rb1.0']
+  label(6:9) = [character(len=24) :: 'gen_alpha_grid_rb0.0', 'gen_alpha_grid_rb0.5', 'gen_alpha_grid_rb0.8', &
+                'gen_alpha_grid_rb1.0']
   om = [(OMAX * k / NOM, k = 1, NOM)]
 
   ierr = 0
@@ -93,7 +93,7 @@ program stability_curves
     cg1 = growth_cfl(sp(i), 1)
     cg2 = growth_cfl(sp(i), 2)
     call attrs(trim(label(i)))
-    if (sp(i)%name == 'gen_alpha') then
+    if (sp(i)%name == 'gen_alpha_grid') then
       write(*, '(a16,3f12.6,2f12.6,3x,2f8.2)') label(i), oc, ocn, empm_hc_omega_crit(rho_b(i)), &
         cl1, cl2, cg1, cg2
     else

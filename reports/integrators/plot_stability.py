@@ -3,7 +3,7 @@
 
 Three panels over Omega = omega*dt (= CFL on the one-cell oscillator): spectral radius,
 numerical damping ratio of the principal root and relative period error (T_bar - T)/T.
-Solid lines: particle at the cell centre (the MPM scheme); the dashed grey line is gen_alpha
+Solid lines: particle at the cell centre (the MPM scheme); the dashed grey line is gen_alpha_grid
 rho_b = 0.8 with the particle on the node, i.e. Hulbert & Chung's nodal scheme. Damping and
 period are drawn only where the principal complex pair exists and the scheme is stable.
 
@@ -51,10 +51,10 @@ def main():
             ax[1].plot(om, xi, color=colour, ls=ls, lw=1.4)
             ax[2].plot(om, pe, color=colour, ls=ls, lw=1.4)
         node = f["oscillator_node"]
-        if "gen_alpha_rb0.8" in node:
-            g = node["gen_alpha_rb0.8"]
+        if "gen_alpha_grid_rb0.8" in node:
+            g = node["gen_alpha_grid_rb0.8"]
             om, rho, xi, pe = curves(g)
-            label = (f"gen_alpha $\\rho_b$=0.8, particle on node = Hulbert-Chung "
+            label = (f"gen_alpha_grid $\\rho_b$=0.8, particle on node = Hulbert-Chung "
                      f"($\\Omega_c$ = {g.attrs['omega_crit']:.3f})")
             ax[0].plot(om, rho, color="grey", ls="--", lw=1.2, label=label)
             ax[1].plot(om, xi, color="grey", ls="--", lw=1.2)

@@ -5,8 +5,8 @@ STYLE = {
     "musl": ("tab:green", ":"),
     "pc_published": ("tab:red", "-"),
     "pc_newmark": ("black", "--"),
-    "gen_alpha_rb0.0": ("tab:purple", "-"),
-    "gen_alpha_rb0.5": ("tab:brown", "-"),
-    "gen_alpha_rb0.8": ("tab:pink", "-"),
-    "gen_alpha_rb1.0": ("tab:olive", "-"),
+    "gen_alpha_grid_rb0.0": ("tab:purple", "-"),
+    "gen_alpha_grid_rb0.5": ("tab:brown", "-"),
+    "gen_alpha_grid_rb0.8": ("tab:pink", "-"),
+    "gen_alpha_grid_rb1.0": ("tab:olive", "-"),
 }

@@ -3,7 +3,7 @@
 !> The amplification matrix of a scheme is built column by column: a small linear model is set
 !> to a unit state, advanced by one `step` of the real integrator, and the new state is read
 !> back. Nothing here re-derives a scheme's formulas (the one closed form, [[empm_hc_matrix]],
-!> is Hulbert & Chung's nodal scheme, the reference gen_alpha is compared with); the closed
+!> is Hulbert & Chung's nodal scheme, the reference gen_alpha_grid is compared with); the closed
 !> forms in docs/integrators.md are checked against these matrices by tests/unit/
 !> test_stability.pf.
 !>

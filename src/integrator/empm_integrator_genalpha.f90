@@ -9,7 +9,7 @@
 !> 4. x_p += Σ N Δu_I;  v_p += Δt Σ N ((1−γ) a_I + γ a⁺_I);  a_p = Σ N a⁺_I
 !> 5. L_p = Σ (Δu_I/Δt) ⊗ ∇N: the strain increment matches the displacement of step 4.
 !>
-!> `gen_alpha_p` (the same α_m, β, γ), second order under large motion
+!> `gen_alpha` (the same α_m, β, γ), second order under large motion
 !> (docs/integrators.md): the α_m recursion runs on the particles,
 !> a_p⁺ = (Σ N f_I/m_I − α_m a_p)/(1 − α_m); the Newmark displacement is formed on the particles
 !> and projected, Δu_I = Δt P2G(v + Δt((½ − β) a + β a⁺))_I (as pc_newmark projects v*), with
@@ -38,7 +38,7 @@ module empm_integrator_genalpha
   type, extends(empm_integrator_t) :: empm_genalpha_t
     real(wp) :: rho_b = 0.8_wp  !! spectral radius at infinite frequency, in [0, 1]
     integer :: variant = GA_PUBLISHED !! GA_PUBLISHED or GA_PARTICLE
-    real(wp), allocatable :: dv(:,:) !! gen_alpha_p: the new particle accelerations of a step
+    real(wp), allocatable :: dv(:,:) !! gen_alpha: the new particle accelerations of a step
                                      !! (ndim, np)
   contains
     procedure :: step => ga_step
@@ -62,14 +62,14 @@ contains
     gamma = 1.5_wp - alpha_m
   end subroutine genalpha_parameters
 
-  !> Registry name: "gen_alpha" or "gen_alpha_p".
+  !> Registry name: "gen_alpha_grid" or "gen_alpha".
   pure function ga_family(self) result(s)
     class(empm_genalpha_t), intent(in) :: self !! integrator
     character(len=:), allocatable :: s        !! name
     if (self%variant == GA_PARTICLE) then
-      s = 'gen_alpha_p'
-    else
       s = 'gen_alpha'
+    else
+      s = 'gen_alpha_grid'
     end if
   end function ga_family
 
@@ -159,7 +159,7 @@ contains
     end associate
   end subroutine ga_step
 
-  !> One `gen_alpha_p` step (module header). The basis and masses are carried from the last
+  !> One `gen_alpha` step (module header). The basis and masses are carried from the last
   !> step; the velocities v_I are mapped only where they are used (the local damping) or with
   !> a new basis (the first step, a restart). The displacement rate
   !> w_p = v_p + Δt((½ − β) a_p + β a_p⁺) is mapped on the same basis, momentum only.

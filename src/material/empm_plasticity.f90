@@ -31,7 +31,7 @@ contains
   !> Q = (I − ½ΔtW)⁻¹(I + ½ΔtW), W = skew(L) (Hughes and Winget 1980). Q is exactly orthogonal,
   !> so the rotation keeps the stress invariants to round-off: the explicit form
   !> σ + Δt(Wσ − σW) grows |σ| by (1 + 4ω²Δt²)^½ per step and pumped energy into spinning
-  !> bodies (colliding disks, +675 % with gen_alpha). Applied to the stress at the start of
+  !> bodies (colliding disks, +675 % with gen_alpha_grid). Applied to the stress at the start of
   !> the step, before the constitutive increment; the rotation is second-order accurate in Δt.
   pure subroutine jaumann_rotate(dt, L, s)
     real(wp), intent(in) :: dt       !! time step [s]

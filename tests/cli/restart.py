@@ -37,7 +37,7 @@ import time
 import h5py
 import numpy as np
 
-SCHEMES = ["usf", "usl", "musl", "pc_published", "pc_newmark", "gen_alpha", "gen_alpha_p"]
+SCHEMES = ["usf", "usl", "musl", "pc_published", "pc_newmark", "gen_alpha_grid", "gen_alpha"]
 SHAPES = ["linear", "ugimp", "bspline2", "lme_g3"]
 
 CASE_2D = """&grid ndim = 2, origin = -0.5, -0.5, h = 0.25, cells = {cells}, {cells} /
@@ -161,7 +161,7 @@ def matrix(empm, work):
                 cells=14, shape=shape, scheme=scheme, hi=2.0, t_end=0.4, every=40,
                 snaps="0.1, 0.2"))
     restart_equals(empm, work, "d1_pc_lme", CASE_1D.format(shape="lme_g3", scheme="pc_newmark"))
-    restart_equals(empm, work, "d1_ga_ugimp", CASE_1D.format(shape="ugimp", scheme="gen_alpha"))
+    restart_equals(empm, work, "d1_ga_ugimp", CASE_1D.format(shape="ugimp", scheme="gen_alpha_grid"))
     restart_equals(empm, work, "d3_pc_lme", CASE_3D.format(shape="lme_g3", scheme="pc_newmark"))
     restart_equals(empm, work, "d3_musl_linear",
                    CASE_3D.format(shape="linear", scheme="musl"))
@@ -170,7 +170,7 @@ def matrix(empm, work):
 def threads(empm, work):
     # 64 x 64 particles (4,096: the threshold of the threaded particle loops).
     for nt in (1, 2):
-        for scheme, shape in (("pc_newmark", "linear"), ("gen_alpha", "lme_g3")):
+        for scheme, shape in (("pc_newmark", "linear"), ("gen_alpha_grid", "lme_g3")):
             restart_equals(empm, work, f"t{nt}_{scheme}_{shape}", CASE_2D.format(
                 cells=44, shape=shape, scheme=scheme, hi=8.5, t_end=0.02, every=8,
                 snaps="0.01"), threads=nt)

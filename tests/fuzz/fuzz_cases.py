@@ -67,7 +67,7 @@ def mutate(text, rng):
             if strs:
                 m = rng.choice(strs)
                 text = text[:m.start()] + rng.choice(["'lme_g0.5'", "'bogus'", "''", "'disk'",
-                                                      "'sine'", "'gen_alpha'", "'neohookean'",
+                                                      "'sine'", "'gen_alpha_grid'", "'neohookean'",
                                                       "'/dev/null'", "'x" * 300 + "'"]) \
                     + text[m.end():]
         elif kind == 8:  # line ends changed (CR only, CRLF)
