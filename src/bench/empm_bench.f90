@@ -183,9 +183,10 @@ contains
       model%pts%stress(1:3, p) = -p0
     end do
     ! Rotation about the block's axis (x, y) = (½, ½): v = ω ẑ × (x − c), corner speed
-    ! 0.1 c_P (c_P = 116 m/s): a corner crosses a cell every ~20 steps at Δt = ½ h/c_P.
+    ! 0.1 c_P (the material's wave speed, 116 m/s for the bench's elastic block): a corner
+    ! crosses a cell every ~20 steps at Δt = ½ h/c_P.
     if (cfg%motion == 'rotate') then
-      s = 0.1_wp * bench_wave_speed() / sqrt(0.5_wp)
+      s = 0.1_wp * model%mats(1)%model%wave_speed(BENCH_RHO) / sqrt(0.5_wp)
       do p = 1, model%pts%np
         model%pts%v(:, p) = 0.0_wp
         model%pts%v(1, p) = -s * (model%pts%x(2, p) - 0.5_wp)
@@ -194,15 +195,15 @@ contains
     end if
     ! Standing wave: component d varies as sin(π(d+k)x_k)-like products, zero on the faces.
     if (cfg%motion == 'vibrate') then
-    do p = 1, model%pts%np
-      do d = 1, nd
-        s = BENCH_V0
-        do k = 1, nd
-          s = s * sin(pi * model%pts%x(k, p) * merge(2.0_wp, 1.0_wp, k == d))
+      do p = 1, model%pts%np
+        do d = 1, nd
+          s = BENCH_V0
+          do k = 1, nd
+            s = s * sin(pi * model%pts%x(k, p) * merge(2.0_wp, 1.0_wp, k == d))
+          end do
+          model%pts%v(d, p) = s
         end do
-        model%pts%v(d, p) = s
       end do
-    end do
     end if
     ! A confined block must stay confined: a free block under −p0 I is not in equilibrium and
     ! would expand (a Cam-Clay block by far more than the grid). The walls x_k = 0 and 1 are
@@ -336,12 +337,6 @@ contains
   !> elastic stiffness K = v p'/κ vanishes with p'; with OCR = 1 the block starts on the yield
   !> surface, so its vibration loads it plastically), 0 for the other models. The block's faces are free:
   !> they unload, and the corner particle fails after ~8 steps (a camclay weakness reported).
-  !> P-wave speed of the bench's material, sqrt(E(1 − ν)/((1 + ν)(1 − 2ν))/ρ) [m/s].
-  pure real(wp) function bench_wave_speed() result(c)
-    c = sqrt(BENCH_E * (1.0_wp - BENCH_NU) / ((1.0_wp + BENCH_NU) * (1.0_wp - 2.0_wp * BENCH_NU)) &
-             / BENCH_RHO)
-  end function bench_wave_speed
-
   pure real(wp) function bench_confinement(name)
     character(len=*), intent(in) :: name !! registry name
     bench_confinement = merge(1.0e4_wp, 0.0_wp, name == 'camclay')
