@@ -319,7 +319,7 @@ contains
       ! step from them); the detailed search (the same verdict, with the first offender named)
       ! runs only when it fails.
       sample = mod(model%step, cfg%history_every) == 0 .or. model%t >= cfg%t_end
-      call screen_step(model, sample, suspect, ekin, egrav, summed)
+      call screen_step(model, sample, suspect, ekin, egrav, estr, summed)
       if (suspect) then
         msg = empm_check_guards(model)
         if (len(msg) > 0) then
@@ -331,11 +331,7 @@ contains
       call add_gravity_work()
 
       if (sample) then
-        if (summed .and. model%want_energy .and. model%diag_step == model%step) then
-          estr = stored_energy(model, model%diag_psi)
-        else
-          call empm_energies(model, psi, ekin, estr, egrav)
-        end if
+        if (.not. summed) call empm_energies(model, psi, ekin, estr, egrav)
         call hist%add_sample(model%t, ekin, estr, egrav, model%pts, model)
       end if
       model%want_energy = .false.
@@ -540,24 +536,33 @@ contains
   end subroutine empm_solve
 
   !> After a step: the guards' cheap test (`suspect` = .false. only when [[empm_check_guards]]
-  !> would return '') and, with `sample`, the kinetic and gravitational energies as
+  !> would return '') and, with `sample` on a step whose stress update left its energy
+  !> densities (`model%want_energy`), the kinetic, stored and gravitational energies as
   !> [[empm_energies]] sums them (`done` then; not when the screen failed first). The material
   !> fields count as screened when this step's stress update screened them
   !> (`model%diag_step`); otherwise they are read here. Positions, velocities and accelerations
   !> are read once, block by block: the screen of their sums, the extreme coordinates (against
   !> the grid box and the mirror planes, with the detailed check's expressions) and the energies
   !> from the block in cache; then the nodal velocities and accelerations.
-  subroutine screen_step(model, sample, suspect, ekin, egrav, done)
+  subroutine screen_step(model, sample, suspect, ekin, egrav, estr, done)
     type(empm_model_t), intent(in) :: model !! simulation state
     logical, intent(in) :: sample           !! sum the energies too
     logical, intent(out) :: suspect         !! the detailed check may find something
     real(wp), intent(out) :: ekin           !! Σ ½ m |v|² [J] (with `done`)
     real(wp), intent(out) :: egrav          !! −Σ m g(t)·x [J] (with `done`)
-    logical, intent(out) :: done            !! the energies were summed
-    real(wp) :: lo(3), hi(3), upper, side, g(3), xlo, xhi
-    integer :: np, nd, p, k, I, nn, q0, q1, n
+    real(wp), intent(out) :: estr           !! Σ V ψ [J] (with `done`)
+    logical, intent(out) :: done            !! the three energies were summed
+    real(wp) :: lo(3), hi(3), upper, side, g(3), xlo, xhi, er
+    integer :: np, nd, p, k, I, nn, q0, q1, n, r
+    logical :: whole
     np = model%pts%np; nd = model%grid%ndim; nn = model%nodes%nnode
-    suspect = .true.; done = .false.; ekin = 0.0_wp; egrav = 0.0_wp
+    suspect = .true.; done = .false.; ekin = 0.0_wp; egrav = 0.0_wp; estr = 0.0_wp
+    ! The stress update left the energy densities of this step (a sampled one) in diag_psi:
+    ! the stored energy is summed in the same pass as the motion energies.
+    whole = sample .and. model%want_energy .and. model%diag_step == model%step
+    if (whole) whole = allocated(model%diag_psi)
+    if (whole) whole = size(model%diag_psi) >= np
+    r = 1; er = 0.0_wp
     if (model%diag_step == model%step) then
       if (.not. model%diag_fine) return
     else
@@ -579,7 +584,7 @@ contains
           end do
           lo(k) = xlo; hi(k) = xhi
         end do
-        if (sample) call motion_energies(model, q0, q1, g, ekin, egrav)
+        if (whole) call all_energies(model, q0, q1, g, ekin, egrav, r, er, estr)
       end do
     end associate
     do k = 1, nd
@@ -597,8 +602,53 @@ contains
     end if
     suspect = .false.
     ekin = 0.5_wp * ekin
-    done = sample
+    done = whole
   end subroutine screen_step
+
+  ! motion_energies and, in the same loop, the stored energy Σ V ψ of particles q0..q1 from
+  ! model%diag_psi: three independent sums, so their additions overlap instead of waiting on
+  ! one another in two passes, each still in its old order (stored_energy: a sum per material
+  ! run `r`, partial `er`, added to `estr` when the run ends).
+  subroutine all_energies(model, q0, q1, g, ekin, egrav, r, er, estr)
+    type(empm_model_t), intent(in) :: model
+    integer, intent(in) :: q0, q1
+    real(wp), intent(in) :: g(3)
+    real(wp), intent(inout) :: ekin, egrav
+    integer, intent(inout) :: r
+    real(wp), intent(inout) :: er, estr
+    integer :: p, p0, pe
+    p0 = q0
+    associate (v => model%pts%v, x => model%pts%x, m => model%pts%m, vol => model%pts%vol, &
+               psi => model%diag_psi)
+      do while (p0 <= q1)
+        pe = min(q1, model%run_last(r))
+        select case (model%grid%ndim)
+        case (2)
+          do p = p0, pe
+            ekin = ekin + m(p) * (v(1, p)**2 + v(2, p)**2)
+            egrav = egrav - m(p) * (g(1) * x(1, p) + g(2) * x(2, p))
+            er = er + vol(p) * psi(p)
+          end do
+        case (3)
+          do p = p0, pe
+            ekin = ekin + m(p) * ((v(1, p)**2 + v(2, p)**2) + v(3, p)**2)
+            egrav = egrav - m(p) * ((g(1) * x(1, p) + g(2) * x(2, p)) + g(3) * x(3, p))
+            er = er + vol(p) * psi(p)
+          end do
+        case default
+          call motion_energies(model, p0, pe, g, ekin, egrav)
+          do p = p0, pe
+            er = er + vol(p) * psi(p)
+          end do
+        end select
+        if (pe == model%run_last(r)) then
+          estr = estr + er
+          er = 0.0_wp; r = r + 1
+        end if
+        p0 = pe + 1
+      end do
+    end associate
+  end subroutine all_energies
 
   ! Add Σ m |v|² and −Σ m g·x of particles q0..q1 to ekin and egrav, one particle after the
   ! other in index order (the order of every earlier version: the energy metrics of the
