@@ -27,7 +27,7 @@
 !> the adapter cannot know the UMAT's stiffness before calling it.
 module empm_material_umat
   use, intrinsic :: iso_c_binding, only: c_ptr, c_funptr, c_double, c_int, c_char, c_size_t, &
-    c_f_procpointer, c_null_ptr, c_null_funptr, c_associated
+    c_f_procpointer, c_null_ptr, c_null_funptr, c_associated, c_loc
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t
@@ -47,6 +47,7 @@ module empm_material_umat
   integer, parameter :: MAX_STATEV = 1000    !! most state variables (NSTATV)
   integer, parameter :: NGUARD = 8           !! guard values after STATEV(NSTATV)
   integer, parameter :: NEXTRA = 4           !! sse, spd, scd, cuts after the STATEV rows
+  integer, parameter :: CMNAME_LEN = 80      !! CHARACTER*80 CMNAME
   !> Guard value: a quiet NaN with a payload no arithmetic produces, compared bit for bit.
   integer(int64), parameter :: GUARD_BITS = int(z'7FF8E3A1C0DE5EED', int64)
 
@@ -101,6 +102,50 @@ module empm_material_umat
       integer(c_size_t), value :: cmname_len       !! hidden length of CMNAME
     end subroutine umat_iface
   end interface
+
+  !> The same subroutine with each argument's address passed as a value: the same calling
+  !> sequence as [[umat_iface]] (an address by value is a reference), used by the common path.
+  !> Its addresses are taken once per batch (the arguments are the same variables for every
+  !> particle) and pushed as they are: by reference, each was recomputed and spilled at every
+  !> call (about 100 instructions, half of what the elastic test UMAT executes).
+  abstract interface
+    subroutine umat_at_iface(stress, statev, ddsdde, sse, spd, scd, rpl, ddsddt, drplde, &
+        drpldt, stran, dstran, time, dtime, temp, dtemp, predef, dpred, cmname, ndi, nshr, &
+        ntens, nstatv, props, nprops, coords, drot, pnewdt, celent, dfgrd0, dfgrd1, noel, npt, &
+        layer, kspt, kstep, kinc, cmname_len) bind(C)
+      import :: c_ptr, c_size_t
+      type(c_ptr), value, intent(in) :: stress, statev, ddsdde, sse, spd, scd, rpl, ddsddt
+      type(c_ptr), value, intent(in) :: drplde, drpldt, stran, dstran, time, dtime, temp, dtemp
+      type(c_ptr), value, intent(in) :: predef, dpred, cmname, ndi, nshr, ntens, nstatv, props
+      type(c_ptr), value, intent(in) :: nprops, coords, drot, pnewdt, celent, dfgrd0, dfgrd1
+      type(c_ptr), value, intent(in) :: noel, npt, layer, kspt, kstep, kinc
+      integer(c_size_t), value, intent(in) :: cmname_len !! hidden length of CMNAME
+    end subroutine umat_at_iface
+  end interface
+
+  !> The UMAT's arguments for a batch: the adapter's copies (the UMAT receives them by
+  !> reference, and a careless one may write to any of them). Fixed sizes: no allocation in the
+  !> time loop, and an overrun of STATEV past the guards still lands in `statev` (up to
+  !> MAX_STATEV + NGUARD values). No default values: a local of the type is not cleared on
+  !> every batch.
+  !> STRESS, STRAN, DSTRAN, DROT, DFGRD0 and DFGRD1 are not here: they are the particle's
+  !> (prepared a chunk at a time in `update_batch`, or in `increments`).
+  type :: umat_args_t
+    real(wp) :: statev(MAX_STATEV + NGUARD), ddsdde(36), sse, spd, scd, rpl
+    real(wp) :: ddsddt(6), drplde(6), drpldt, time(2), dtime, temp
+    real(wp) :: dtemp, predef(1), dpred(1)
+    character(kind=c_char) :: cmname(CMNAME_LEN)
+    integer(c_int) :: ndi, nshr, ntens, nstatv
+    real(wp) :: props(UMAT_MAX_PROPS)
+    integer(c_int) :: nprops
+    real(wp) :: coords(3), pnewdt, celent
+    integer(c_int) :: noel, npt, layer, kspt, kstep, kinc
+    !> The addresses of the 37 arguments, in order, for [[umat_at_iface]]. Here, in the record
+    !> whose addresses the UMAT receives, so that the compiler reads them from memory at each
+    !> call: it may not assume that they survive the previous one, and does not recompute and
+    !> spill them (as it did for a local array, whose values it knew).
+    type(c_ptr) :: at(37)
+  end type umat_args_t
 
   !> Adapter to a user material subroutine with the Abaqus UMAT argument list.
   type, extends(empm_material_t) :: empm_umat_t
@@ -306,7 +351,6 @@ contains
     real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
     type(empm_material_ctx_t), intent(in) :: ctx           !! time, step, batch position
     integer, intent(out) :: info                           !! 0 ok; k > 0 particle k failed
-    procedure(umat_iface), pointer :: umat
     integer :: n
     info = 0
     n = size(rho)
@@ -316,285 +360,380 @@ contains
       info = -1
       return
     end if
-    call c_f_procpointer(self%fun, umat)
     if (self%thread_safe) then
-      call update_batch(self, umat, dt, L, F, strain, stress, state, rho, ctx, info)
+      call update_batch(self, dt, n, L, F, strain, stress, size(state, 1), state, rho, ctx, info)
     else
       !$omp critical (empm_umat_calls)
-      call update_batch(self, umat, dt, L, F, strain, stress, state, rho, ctx, info)
+      call update_batch(self, dt, n, L, F, strain, stress, size(state, 1), state, rho, ctx, info)
       !$omp end critical (empm_umat_calls)
     end if
   end subroutine um_update
 
-  ! The particles of a batch, one after the other; a refused increment (PNEWDT < 1) is retried
-  ! from the particle's unchanged state in more sub-increments.
-  subroutine update_batch(self, umat, dt, L, F, strain, stress, state, rho, ctx, info)
+  ! The particles of a batch, a chunk at a time: pass 1 prepares every particle's STRESS, STRAN,
+  ! DSTRAN, DROT and DFGRD1, pass 2 calls the UMAT on them particle after particle and stores
+  ! what it accepts; a refused increment (PNEWDT < 1) is retried from the particle's unchanged
+  ! state in more sub-increments (`increments`).
+  !
+  ! Written for the cost around the call, which was most of what the adapter did (more than
+  ! twice the time of the elastic test UMAT): the rotation's chain of dependent products no
+  ! longer waits between two calls; explicit-shape particle arrays (fixed strides, no descriptors); no internal
+  ! procedures (host association kept the variables they touch in a frame record in memory,
+  ! reloaded after each store to an argument); the UMAT's addresses taken once per batch and
+  ! pushed as they are ([[umat_at_iface]]); statev copied without a call of memcpy; one test of
+  ! the guards and the stress when all is well.
+  subroutine update_batch(self, dt, n, L, F, strain, stress, lds, state, rho, ctx, info)
     class(empm_umat_t), intent(in) :: self
-    procedure(umat_iface), pointer, intent(in) :: umat
     real(wp), intent(in) :: dt
-    real(wp), intent(in), contiguous :: L(:,:,:)
-    real(wp), intent(inout), contiguous :: F(:,:,:), strain(:,:), stress(:,:), state(:,:), rho(:)
+    integer, intent(in) :: n, lds
+    real(wp), intent(in) :: L(3,3,n)
+    real(wp), intent(inout), target :: F(3,3,n)
+    real(wp), intent(inout) :: strain(6,n), stress(6,n), state(lds,n), rho(n)
     type(empm_material_ctx_t), intent(in) :: ctx
     integer, intent(inout) :: info
-    ! Fixed sizes: no allocation in the time loop, and an overrun of STATEV past the guards
-    ! still lands in this array (up to MAX_STATEV + NGUARD values).
-    real(wp) :: statev(MAX_STATEV + NGUARD), props(UMAT_MAX_PROPS)
-    real(wp) :: de(6), tr, pnewdt, time(2), sse, spd, scd, rpl, ddsddt(6), drplde(6), drpldt
-    real(wp) :: temp, dtemp, predef(1), dpred(1), coords(3), celent, dtime, ddsdde(36)
-    character(len=80) :: cmname
-    integer(c_int) :: ndi, nshr, ntens, nstatv, nprops, noel, npt, layer, kspt, kstep, kinc
-    integer, parameter :: CHUNK = 64
-    real(wp) :: jac(CHUNK), a3c(CHUNK), cc(CHUNK)
-    integer :: p, p0, p1, k, why, nsv, i
+    type(umat_args_t), target :: a
+    procedure(umat_at_iface), pointer :: umat_at
+    ! A chunk is a stress block of the integrator: its arguments stay in cache.
+    integer, parameter :: CHUNK = 32
+    ! Per particle of the chunk: the UMAT's STRESS, STRAN, DSTRAN (Abaqus order), DROT, DFGRD1
+    ! (or the copy of F passed as both DFGRD0 and DFGRD1), the strain after an accepted step,
+    ! 1 + tr Δε (the volume ratio) and ρ's divisor (stays 1 for a particle that failed).
+    real(wp), target :: sigc(6, CHUNK), stranc(6, CHUNK), dstranc(6, CHUNK)
+    real(wp), target :: drotc(3, 3, CHUNK), f1c(3, 3, CHUNK)
+    real(wp) :: epc(6, CHUNK), vr(CHUNK), jac(CHUNK)
+    real(wp) :: d(6), d1, d2, d3, d4, d5, d6, t, hdt, a3, cq, ct, st, s1, s2, s6, e1, e2, e6
+    real(wp) :: r1, r2, pn
+    integer(int64) :: x
+    integer :: p, p0, m, j, k, why, nsv, ntens, i, first
+    logical :: rs, rf
     nsv = self%nstatv
-    ! Copies: the UMAT receives them by reference and a careless one may write to them.
-    props = 0.0_wp
-    props(1:size(self%props)) = self%props
-    cmname = self%cmname
-    ndi = 3
-    nshr = merge(3, 1, ctx%ndim == 3)
-    ntens = ndi + nshr
-    nstatv = int(nsv, c_int); nprops = int(size(self%props), c_int)
-    npt = 1; layer = 1; kspt = 1; kstep = 1; kinc = int(ctx%step, c_int)
-    coords = 0.0_wp; celent = ctx%h; temp = 0.0_wp; dtemp = 0.0_wp
-    predef = 0.0_wp; dpred = 0.0_wp
-    ! Outputs the adapter does not use, and the guards after STATEV(NSTATV): set once per
-    ! batch (the guards are checked after every call, and a changed one ends the batch's use).
-    ddsdde = 0.0_wp; ddsddt = 0.0_wp; drplde = 0.0_wp; rpl = 0.0_wp; drpldt = 0.0_wp
-    do i = nsv + 1, nsv + NGUARD
-      statev(i) = transfer(GUARD_BITS, 1.0_wp)
-    end do
-    ! The density ρ ← ρ/(1 + tr Δε) afterwards, a chunk at a time in one vectorised division
-    ! (a division per particle inside the loop stalled it); a particle that failed keeps ρ
-    ! (divided by 1).
-    do p0 = 1, size(rho), CHUNK
-    p1 = min(size(rho), p0 + CHUNK - 1)
-    jac(1:p1 - p0 + 1) = 1.0_wp
-    ! The plane rotation's cos and sin for the chunk, in one vectorised pass (its division
-    ! per particle, next to the UMAT call, stalled the loop). Used when the spin is about z
-    ! alone (`single`); c = 2/(1 + a₃²) as in jaumann_rotate.
-    do p = p0, p1
-      a3c(p - p0 + 1) = 0.25_wp * dt * (L(2,1,p) - L(1,2,p))
-      cc(p - p0 + 1) = 2.0_wp / (1.0_wp + a3c(p - p0 + 1)**2)
-    end do
-    do p = p0, p1
-      associate (Lp => L(:,:,p))
-        de(1) = dt * Lp(1,1)
-        de(2) = dt * Lp(2,2)
-        de(3) = dt * Lp(3,3)
-        de(4) = 0.5_wp * dt * (Lp(2,3) + Lp(3,2))
-        de(5) = 0.5_wp * dt * (Lp(1,3) + Lp(3,1))
-        de(6) = 0.5_wp * dt * (Lp(1,2) + Lp(2,1))
-      end associate
-      tr = de(1) + de(2) + de(3)
-      if (1.0_wp + tr <= 0.0_wp) then ! as the native models: an inverted particle
-        call fail(p, WHY_VOLUME)
-        cycle
-      end if
-      noel = int(ctx%first + p - 1, c_int)
-      ! The common case, one increment accepted: no copies of the particle beyond the UMAT's
-      ! own arguments (the general path below reruns a refused step from the particle's
-      ! unchanged values).
-      call single(L(:,:,p), a3c(p - p0 + 1), cc(p - p0 + 1), stress(:,p), strain(:,p), &
-        F(:,:,p), state(1:nsv + NEXTRA, p), why, pnewdt)
-      if (why == 0) then
-        jac(p - p0 + 1) = 1.0_wp + tr
-        cycle
-      end if
-      if (why /= WHY_PNEWDT) then
-        call fail(p, why)
-        cycle
-      end if
-      k = min(UMAT_MAX_SUB, max(2, ceiling(1.0_wp / max(pnewdt, 1.0_wp / UMAT_MAX_SUB))))
-      do
-        call increments(L(:,:,p), stress(:,p), strain(:,p), F(:,:,p), state(1:nsv + NEXTRA, p), &
-          k, why, pnewdt)
-        if (why /= WHY_PNEWDT .or. k >= UMAT_MAX_SUB) exit
-        ! At least the ratio asked for, and at least twice as many as refused.
-        k = min(UMAT_MAX_SUB, max(2 * k, &
-          ceiling(real(k, wp) / max(pnewdt, 1.0_wp / UMAT_MAX_SUB))))
-      end do
-      if (why /= 0) then
-        call fail(p, why)
-        cycle
-      end if
-      if (k > 1) state(nsv + NEXTRA, p) = state(nsv + NEXTRA, p) + 1.0_wp
-      jac(p - p0 + 1) = 1.0_wp + tr
-    end do
-    rho(p0:p1) = rho(p0:p1) / jac(1:p1 - p0 + 1)
-    end do
+    t = ctx%t; first = ctx%first
+    rs = self%uses_stran; rf = self%uses_dfgrd
+    hdt = 0.5_wp * dt
+    call umat_args_init(self, ctx, a)
+    ntens = a%ntens
+    call c_f_procpointer(self%fun, umat_at)
+    do p0 = 1, n, CHUNK
+    m = min(n - p0 + 1, CHUNK)
 
-  contains
-
-    subroutine fail(p, code)
-      integer, intent(in) :: p, code
-      if (info == 0) info = p
-      !$omp atomic write
-      self%why = code
-    end subroutine fail
-
-    ! What a UMAT call returned: WHY_NSTATV when it wrote past STATEV(NSTATV) (the guards,
-    ! checked bit for bit in one branch), WHY_NONFINITE for a non-finite stress, WHY_PNEWDT
-    ! when it asked for a smaller increment, else 0.
-    integer function verdict(sg, pnew) result(why)
-      real(wp), intent(in) :: sg(6), pnew
-      integer(int64) :: g
-      integer :: i
-      g = 0
-      do i = nsv + 1, nsv + NGUARD
-        g = ior(g, ieor(transfer(statev(i), GUARD_BITS), GUARD_BITS))
-      end do
-      why = 0
-      if (g /= 0) then
-        why = WHY_NSTATV
-      else if (.not. all(finite(sg(1:ntens)))) then
-        why = WHY_NONFINITE
-      else if (pnew < 1.0_wp) then
-        why = WHY_PNEWDT
-      end if
-    end function verdict
-
-    ! One particle's step in one increment (k = 1 of `increments`, with the same arithmetic),
-    ! writing the particle only when the UMAT's result is accepted; why and pnewdt as there.
-    subroutine single(Lp, a3, c, sp, ep, Fp, stp, why, pnewdt)
-      real(wp), intent(in) :: Lp(3,3)
-      real(wp), intent(in) :: a3, c  ! ¼Δt(L₂₁ − L₁₂) and 2/(1 + a3²)
-      real(wp), intent(inout) :: sp(6), ep(6), Fp(3,3), stp(nsv + NEXTRA)
-      integer, intent(out) :: why
-      real(wp), intent(out) :: pnewdt
-      real(wp) :: drot(3,3), F1(3,3), sig(6), stran(6), dstran(6), s(6), e(6)
-      integer :: i
-      logical :: spin
-      real(wp) :: ct, st
-      e = ep
-      if (ntens == 4 .and. Lp(3,2) == Lp(2,3) .and. Lp(1,3) == Lp(3,1)) then
+    ! Pass 1, the arguments, for the chunk. Its iterations are independent, so that their
+    ! latencies overlap (the rotation's dependent products, a division); in the pass of the
+    ! calls they would add up particle after particle.
+    do j = 1, m
+      p = p0 + j - 1
+      d1 = dt * L(1,1,p)
+      d2 = dt * L(2,2,p)
+      d3 = dt * L(3,3,p)
+      d4 = hdt * (L(2,3,p) + L(3,2,p)) ! 0.5 Δt once: the same product
+      d5 = hdt * (L(1,3,p) + L(3,1,p))
+      d6 = hdt * (L(1,2,p) + L(2,1,p))
+      vr(j) = 1.0_wp + (d1 + d2 + d3)
+      jac(j) = 1.0_wp
+      if (ntens == 4 .and. L(3,2,p) == L(2,3,p) .and. L(1,3,p) == L(3,1,p)) then
         ! Plane strain and 1D (spin about z alone): the closed form of `rotate` written
-        ! straight into the Abaqus order, scalar by scalar (no round trip through memory).
-        drot = 0.0_wp
-        drot(3,3) = 1.0_wp
+        ! straight into the Abaqus order, scalar by scalar; Q = I when a₃ = 0 (not the
+        ! rotation by the identity, which may change the sign of a zero), c = 2/(1 + a₃²) as
+        ! in jaumann_rotate.
+        a3 = 0.25_wp * dt * (L(2,1,p) - L(1,2,p))
+        cq = 2.0_wp / (1.0_wp + a3**2)
+        s1 = stress(1,p); s2 = stress(2,p); s6 = stress(6,p)
+        e1 = strain(1,p); e2 = strain(2,p); e6 = strain(6,p)
         if (a3 /= 0.0_wp) then
-          ct = 1.0_wp - c * a3**2; st = c * a3
-          sig(1) = ct * ct * sp(1) - 2.0_wp * ct * st * sp(6) + st * st * sp(2)
-          sig(2) = st * st * sp(1) + 2.0_wp * ct * st * sp(6) + ct * ct * sp(2)
-          sig(4) = ct * st * (sp(1) - sp(2)) + (ct * ct - st * st) * sp(6)
-          if (self%uses_stran) then
-            stran(1) = ct * ct * e(1) - 2.0_wp * ct * st * e(6) + st * st * e(2)
-            stran(2) = st * st * e(1) + 2.0_wp * ct * st * e(6) + ct * ct * e(2)
-            e(6) = ct * st * (e(1) - e(2)) + (ct * ct - st * st) * e(6)
-            e(1) = stran(1); e(2) = stran(2)
+          ct = 1.0_wp - cq * a3**2; st = cq * a3
+          r1 = ct * ct * s1 - 2.0_wp * ct * st * s6 + st * st * s2
+          r2 = st * st * s1 + 2.0_wp * ct * st * s6 + ct * ct * s2
+          s6 = ct * st * (s1 - s2) + (ct * ct - st * st) * s6
+          s1 = r1; s2 = r2
+          if (rs) then
+            r1 = ct * ct * e1 - 2.0_wp * ct * st * e6 + st * st * e2
+            r2 = st * st * e1 + 2.0_wp * ct * st * e6 + ct * ct * e2
+            e6 = ct * st * (e1 - e2) + (ct * ct - st * st) * e6
+            e1 = r1; e2 = r2
           end if
         else
           ct = 1.0_wp; st = 0.0_wp
-          sig(1) = sp(1); sig(2) = sp(2); sig(4) = sp(6)
         end if
-        drot(1,1) = ct; drot(2,2) = ct; drot(2,1) = st; drot(1,2) = -st
-        sig(3) = sp(3)
-        stran(1) = e(1); stran(2) = e(2); stran(3) = e(3); stran(4) = 2.0_wp * e(6)
-        dstran(1) = de(1); dstran(2) = de(2); dstran(3) = de(3); dstran(4) = 2.0_wp * de(6)
+        sigc(1, j) = s1; sigc(2, j) = s2; sigc(3, j) = stress(3,p); sigc(4, j) = s6
+        stranc(1, j) = e1; stranc(2, j) = e2; stranc(3, j) = strain(3,p)
+        stranc(4, j) = 2.0_wp * e6
+        dstranc(1, j) = d1; dstranc(2, j) = d2; dstranc(3, j) = d3
+        dstranc(4, j) = 2.0_wp * d6
+        ! Past NTENS = 4: defined, though no UMAT reads them.
+        sigc(5, j) = 0.0_wp; sigc(6, j) = 0.0_wp; stranc(5, j) = 0.0_wp; stranc(6, j) = 0.0_wp
+        dstranc(5, j) = 0.0_wp; dstranc(6, j) = 0.0_wp
+        epc(1, j) = e1 + d1; epc(2, j) = e2 + d2; epc(3, j) = strain(3,p) + d3
+        epc(4, j) = strain(4,p) + d4; epc(5, j) = strain(5,p) + d5; epc(6, j) = e6 + d6
+        drotc(1, 1, j) = ct; drotc(2, 1, j) = st; drotc(3, 1, j) = 0.0_wp
+        drotc(1, 2, j) = -st; drotc(2, 2, j) = ct; drotc(3, 2, j) = 0.0_wp
+        drotc(1, 3, j) = 0.0_wp; drotc(2, 3, j) = 0.0_wp; drotc(3, 3, j) = 1.0_wp
       else
-        s = sp
-        call step_rotation(dt, Lp, drot, spin)
-        if (spin) then
-          call rotate(drot, s)
-          if (self%uses_stran) call rotate(drot, e)
-        end if
-        call to_abaqus(ntens, s, 1.0_wp, sig)
-        call to_abaqus(ntens, e, 2.0_wp, stran)
-        call to_abaqus(ntens, de, 2.0_wp, dstran)
+        call prepare_general(ntens, dt, rs, L(:,:,p), stress(:,p), strain(:,p), &
+          [d1, d2, d3, d4, d5, d6], sigc(:, j), stranc(:, j), dstranc(:, j), drotc(:, :, j), &
+          epc(:, j))
       end if
-      do i = 1, nsv
-        statev(i) = stp(i)
-      end do
-      sse = stp(nsv + 1); spd = stp(nsv + 2); scd = stp(nsv + 3)
-      time = ctx%t
-      dtime = dt
-      pnewdt = 1.0e36_wp
-      if (self%uses_dfgrd) then
-        call advance(ntens, dt, Lp, Fp, F1)
-        call umat(sig, statev, ddsdde, sse, spd, scd, rpl, ddsddt, drplde, drpldt, stran, &
-          dstran, time, dtime, temp, dtemp, predef, dpred, cmname, ndi, nshr, ntens, &
-          nstatv, props, nprops, coords, drot, pnewdt, celent, Fp, F1, noel, npt, &
-          layer, kspt, kstep, kinc, int(len(cmname), c_size_t))
+      ! DFGRD1: F advanced with L (DFGRD0 is the particle's F); or F unchanged, a copy
+      ! passed as both (a careless UMAT writing to them does not change the particle's F).
+      if (rf) then
+        call advance(a%ntens, dt, L(:,:,p), F(:,:,p), f1c(:,:,j))
       else
-        ! DFGRD0 = DFGRD1 = F (inputs the UMAT must not change; a copy keeps a careless one
-        ! from changing the particle's F).
-        F1 = Fp
-        call umat(sig, statev, ddsdde, sse, spd, scd, rpl, ddsddt, drplde, drpldt, stran, &
-          dstran, time, dtime, temp, dtemp, predef, dpred, cmname, ndi, nshr, ntens, &
-          nstatv, props, nprops, coords, drot, pnewdt, celent, F1, F1, noel, npt, &
-          layer, kspt, kstep, kinc, int(len(cmname), c_size_t))
+        f1c(:,:,j) = F(:,:,p)
       end if
-      why = verdict(sig, pnewdt)
-      if (why /= 0) return
-      call from_abaqus(ntens, sig, sp)
-      ep = e + de
-      if (self%uses_dfgrd) Fp = F1
-      do i = 1, nsv
-        stp(i) = statev(i)
-      end do
-      stp(nsv + 1) = sse; stp(nsv + 2) = spd; stp(nsv + 3) = scd
-    end subroutine single
+    end do
 
-    ! One particle's step in k equal sub-increments, on local copies that are stored only when
-    ! every sub-increment succeeded (so a refusal or a failure leaves the particle as it was).
-    ! why = 0 on success, else WHY_* (pnewdt then holds the UMAT's ratio when it refused).
-    ! Explicit-shape dummies: the particle's values are then plain memory, not sections.
-    subroutine increments(Lp, sp, ep, Fp, stp, k, why, pnewdt)
-      real(wp), intent(in) :: Lp(3,3)
-      real(wp), intent(inout) :: sp(6), ep(6), Fp(3,3), stp(nsv + NEXTRA)
-      integer, intent(in) :: k
-      integer, intent(out) :: why
-      real(wp), intent(out) :: pnewdt
-      real(wp) :: h, dsub(6), drot(3,3), F0(3,3), F1(3,3), sig(6), stran(6), dstran(6)
-      real(wp) :: s(6), e(6)
-      integer :: j, i
-      logical :: spin
-      h = dt / k
-      if (k == 1) then
-        dsub = de
-      else
-        dsub = strain_increment(h, Lp)
+    ! Pass 2, the calls, particle after particle: the particle is written only when the UMAT's
+    ! result is accepted (a refused step is rerun below from the particle's unchanged values).
+    do j = 1, m
+      p = p0 + j - 1
+      if (vr(j) <= 0.0_wp) then ! as the native models: an inverted particle
+        call record_failure(self, p, WHY_VOLUME, info)
+        cycle
       end if
-      s = sp; e = ep; F0 = Fp
-      do i = 1, nsv
-        statev(i) = stp(i)
+      a%at(1) = c_loc(sigc(1, j)); a%at(11) = c_loc(stranc(1, j))
+      a%at(12) = c_loc(dstranc(1, j)); a%at(27) = c_loc(drotc(1, 1, j))
+      a%at(31) = c_loc(f1c(1, 1, j))
+      if (rf) then
+        a%at(30) = c_loc(F(1, 1, p))
+      else
+        a%at(30) = a%at(31)
+      end if
+      ! STATEV, SSE, SPD, SCD from the particle. Two values an iteration: a plain copy loop is
+      ! compiled to a call of memcpy, which costs more than the copy of a few values.
+      do i = 1, nsv - 1, 2
+        a%statev(i) = state(i,p); a%statev(i + 1) = state(i + 1,p)
       end do
-      sse = stp(nsv + 1); spd = stp(nsv + 2); scd = stp(nsv + 3)
-      why = 0; pnewdt = 1.0_wp
-      call step_rotation(h, Lp, drot, spin)
-      do j = 1, k
-        if (spin) then
-          call rotate(drot, s)
-          if (self%uses_stran) call rotate(drot, e)
+      if (iand(nsv, 1) == 1) a%statev(nsv) = state(nsv,p)
+      a%sse = state(nsv + 1,p); a%spd = state(nsv + 2,p); a%scd = state(nsv + 3,p)
+      a%time = t
+      a%dtime = dt
+      a%pnewdt = 1.0e36_wp ! "no limit": a UMAT lowers it to ask for a smaller increment
+      a%noel = int(first + p - 1, c_int)
+      associate (r => a%at)
+        call umat_at(r(1), r(2), r(3), r(4), r(5), r(6), r(7), r(8), r(9), r(10), r(11), r(12), &
+          r(13), r(14), r(15), r(16), r(17), r(18), r(19), r(20), r(21), r(22), r(23), r(24), &
+          r(25), r(26), r(27), r(28), r(29), r(30), r(31), r(32), r(33), r(34), r(35), r(36), &
+          r(37), int(CMNAME_LEN, c_size_t))
+      end associate
+      ! The verdict's test (`verdict`, which names the reason, runs only when it fails).
+      x = ior(guards_changed(a%statev(nsv + 1:nsv + NGUARD)), nonfinite_stress(ntens, sigc(:, j)))
+      if (x == 0) then
+        if (.not. (a%pnewdt < 1.0_wp)) then
+          call from_abaqus(a%ntens, sigc(:, j), stress(:,p))
+          strain(:,p) = epc(:, j)
+          if (rf) F(:,:,p) = f1c(:,:,j)
+          do i = 1, nsv - 1, 2
+            state(i,p) = a%statev(i); state(i + 1,p) = a%statev(i + 1)
+          end do
+          if (iand(nsv, 1) == 1) state(nsv,p) = a%statev(nsv)
+          state(nsv + 1,p) = a%sse; state(nsv + 2,p) = a%spd; state(nsv + 3,p) = a%scd
+          jac(j) = vr(j)
+          cycle
         end if
-        if (self%uses_dfgrd) then
-          call advance(ntens, h, Lp, F0, F1)
-        else
-          F1 = F0
-        end if
-        call to_abaqus(ntens, s, 1.0_wp, sig)
-        call to_abaqus(ntens, e, 2.0_wp, stran)
-        call to_abaqus(ntens, dsub, 2.0_wp, dstran)
-        time = ctx%t + (j - 1) * h
-        dtime = h
-        pnewdt = 1.0e36_wp ! "no limit": a UMAT lowers it to ask for a smaller increment
-        call umat(sig, statev, ddsdde, sse, spd, scd, rpl, ddsddt, drplde, drpldt, stran, &
-          dstran, time, dtime, temp, dtemp, predef, dpred, cmname, ndi, nshr, ntens, &
-          nstatv, props, nprops, coords, drot, pnewdt, celent, F0, F1, noel, npt, &
-          layer, kspt, kstep, kinc, int(len(cmname), c_size_t))
-        why = verdict(sig, pnewdt)
-        if (why /= 0) return
-        call from_abaqus(ntens, sig, s)
-        e = e + dsub
-        F0 = F1
+      end if
+      why = verdict(a%statev(nsv + 1:nsv + NGUARD), ntens, sigc(:, j), a%pnewdt)
+      if (why /= WHY_PNEWDT) then
+        call record_failure(self, p, why, info)
+        cycle
+      end if
+      ! Refused: the step again from the particle's unchanged values, in k sub-increments.
+      pn = a%pnewdt
+      k = min(UMAT_MAX_SUB, max(2, ceiling(1.0_wp / max(pn, 1.0_wp / UMAT_MAX_SUB))))
+      ! Δε as in pass 1 (not from DSTRAN, which a careless UMAT may have changed)
+      d(1) = dt * L(1,1,p); d(2) = dt * L(2,2,p); d(3) = dt * L(3,3,p)
+      d(4) = hdt * (L(2,3,p) + L(3,2,p)); d(5) = hdt * (L(1,3,p) + L(3,1,p))
+      d(6) = hdt * (L(1,2,p) + L(2,1,p))
+      do
+        call increments(self, a, t, dt, L(:,:,p), d, stress(:,p), strain(:,p), F(:,:,p), &
+          state(1:nsv + NEXTRA, p), k, why, pn)
+        if (why /= WHY_PNEWDT .or. k >= UMAT_MAX_SUB) exit
+        ! At least the ratio asked for, and at least twice as many as refused.
+        k = min(UMAT_MAX_SUB, max(2 * k, &
+          ceiling(real(k, wp) / max(pn, 1.0_wp / UMAT_MAX_SUB))))
       end do
-      sp = s; ep = e; Fp = F0
-      do i = 1, nsv
-        stp(i) = statev(i)
-      end do
-      stp(nsv + 1) = sse; stp(nsv + 2) = spd; stp(nsv + 3) = scd
-    end subroutine increments
+      if (why /= 0) then
+        call record_failure(self, p, why, info)
+        cycle
+      end if
+      if (k > 1) state(nsv + NEXTRA, p) = state(nsv + NEXTRA, p) + 1.0_wp
+      jac(j) = vr(j)
+    end do
+    ! The density ρ ← ρ/(1 + tr Δε), for the chunk in one vectorised division; a particle that
+    ! failed keeps ρ (divided by 1).
+    rho(p0:p0 + m - 1) = rho(p0:p0 + m - 1) / jac(1:m)
+    end do
   end subroutine update_batch
+
+  ! The batch's constant arguments (copies: the UMAT receives them by reference and a careless
+  ! one may write to them), the outputs the adapter does not use, and the guards after
+  ! STATEV(NSTATV): set once per batch (the guards are checked after every call, and a changed
+  ! one ends the batch's use).
+  subroutine umat_args_init(self, ctx, a)
+    class(empm_umat_t), intent(in) :: self
+    type(empm_material_ctx_t), intent(in) :: ctx
+    type(umat_args_t), intent(inout), target :: a
+    integer :: i, np
+    np = size(self%props)
+    a%props(1:np) = self%props
+    a%props(np + 1:) = 0.0_wp
+    do i = 1, CMNAME_LEN
+      a%cmname(i) = self%cmname(i:i)
+    end do
+    a%ndi = 3
+    a%nshr = merge(3, 1, ctx%ndim == 3)
+    a%ntens = a%ndi + a%nshr
+    a%nstatv = int(self%nstatv, c_int); a%nprops = int(np, c_int)
+    a%npt = 1; a%layer = 1; a%kspt = 1; a%kstep = 1; a%kinc = int(ctx%step, c_int)
+    a%coords = 0.0_wp; a%celent = ctx%h; a%temp = 0.0_wp; a%dtemp = 0.0_wp
+    a%predef = 0.0_wp; a%dpred = 0.0_wp
+    a%ddsdde = 0.0_wp; a%ddsddt = 0.0_wp; a%drplde = 0.0_wp; a%rpl = 0.0_wp; a%drpldt = 0.0_wp
+    do i = self%nstatv + 1, self%nstatv + NGUARD
+      a%statev(i) = transfer(GUARD_BITS, 1.0_wp)
+    end do
+    ! The addresses; those of STRESS (1), STRAN (11), DSTRAN (12), DROT (27), DFGRD0 (30) and
+    ! DFGRD1 (31) are set per particle.
+    a%at(2) = c_loc(a%statev); a%at(3) = c_loc(a%ddsdde); a%at(4) = c_loc(a%sse)
+    a%at(5) = c_loc(a%spd); a%at(6) = c_loc(a%scd); a%at(7) = c_loc(a%rpl)
+    a%at(8) = c_loc(a%ddsddt); a%at(9) = c_loc(a%drplde); a%at(10) = c_loc(a%drpldt)
+    a%at(13) = c_loc(a%time); a%at(14) = c_loc(a%dtime); a%at(15) = c_loc(a%temp)
+    a%at(16) = c_loc(a%dtemp); a%at(17) = c_loc(a%predef); a%at(18) = c_loc(a%dpred)
+    a%at(19) = c_loc(a%cmname); a%at(20) = c_loc(a%ndi); a%at(21) = c_loc(a%nshr)
+    a%at(22) = c_loc(a%ntens); a%at(23) = c_loc(a%nstatv); a%at(24) = c_loc(a%props)
+    a%at(25) = c_loc(a%nprops); a%at(26) = c_loc(a%coords); a%at(28) = c_loc(a%pnewdt)
+    a%at(29) = c_loc(a%celent); a%at(32) = c_loc(a%noel); a%at(33) = c_loc(a%npt)
+    a%at(34) = c_loc(a%layer); a%at(35) = c_loc(a%kspt); a%at(36) = c_loc(a%kstep)
+    a%at(37) = c_loc(a%kinc)
+  end subroutine umat_args_init
+
+  ! Particle p failed for `code` (WHY_*): info names the batch's first failure.
+  subroutine record_failure(self, p, code, info)
+    class(empm_umat_t), intent(in) :: self
+    integer, intent(in) :: p, code
+    integer, intent(inout) :: info
+    if (info == 0) info = p
+    !$omp atomic write
+    self%why = code
+  end subroutine record_failure
+
+  ! STRESS, STRAN, DSTRAN, DROT for one particle in the general case (3D, or a spin not about z
+  ! alone): Q from step_rotation, the stress (and the strain when `rs`) rotated, the Abaqus
+  ! order; epn = the strain after the step.
+  pure subroutine prepare_general(ntens, dt, rs, Lp, sp, ep, de, sig, stran, dstran, drot, epn)
+    integer, intent(in) :: ntens
+    real(wp), intent(in) :: dt, Lp(3,3), sp(6), ep(6), de(6)
+    logical, intent(in) :: rs
+    real(wp), intent(out) :: sig(6), stran(6), dstran(6), drot(3,3), epn(6)
+    real(wp) :: s(6), e(6)
+    logical :: spin
+    s = sp; e = ep
+    call step_rotation(dt, Lp, drot, spin)
+    if (spin) then
+      call rotate(drot, s)
+      if (rs) call rotate(drot, e)
+    end if
+    call to_abaqus(int(ntens, c_int), s, 1.0_wp, sig)
+    call to_abaqus(int(ntens, c_int), e, 2.0_wp, stran)
+    call to_abaqus(int(ntens, c_int), de, 2.0_wp, dstran)
+    epn = e + de
+  end subroutine prepare_general
+
+  ! What a UMAT call returned: WHY_NSTATV when it wrote past STATEV(NSTATV) (the guards, checked
+  ! bit for bit), WHY_NONFINITE for a non-finite stress, WHY_PNEWDT when it asked for a smaller
+  ! increment, else 0.
+  pure integer function verdict(guards, ntens, sg, pnew) result(why)
+    real(wp), intent(in) :: guards(NGUARD), sg(6), pnew
+    integer, intent(in) :: ntens
+    why = 0
+    if (guards_changed(guards) /= 0) then
+      why = WHY_NSTATV
+    else if (nonfinite_stress(ntens, sg) /= 0) then
+      why = WHY_NONFINITE
+    else if (pnew < 1.0_wp) then
+      why = WHY_PNEWDT
+    end if
+  end function verdict
+
+  ! Nonzero when a guard after STATEV(NSTATV) is no longer GUARD_BITS: the differences or-ed,
+  ! without a branch per value.
+  pure integer(int64) function guards_changed(guards) result(g)
+    real(wp), intent(in) :: guards(NGUARD)
+    integer :: i
+    g = 0
+    do i = 1, NGUARD
+      g = ior(g, ieor(transfer(guards(i), GUARD_BITS), GUARD_BITS))
+    end do
+  end function guards_changed
+
+  ! Nonzero when a component of STRESS(1:NTENS) is Inf or NaN ([[nonfinite]], or-ed).
+  pure integer(int64) function nonfinite_stress(ntens, sg) result(x)
+    integer, intent(in) :: ntens
+    real(wp), intent(in) :: sg(6)
+    x = ior(ior(nonfinite(sg(1)), nonfinite(sg(2))), ior(nonfinite(sg(3)), nonfinite(sg(4))))
+    if (ntens == 6) x = ior(x, ior(nonfinite(sg(5)), nonfinite(sg(6))))
+  end function nonfinite_stress
+
+  ! One particle's step in k equal sub-increments, on local copies that are stored only when
+  ! every sub-increment succeeded (so a refusal or a failure leaves the particle as it was).
+  ! why = 0 on success, else WHY_* (pnewdt then holds the UMAT's ratio when it refused).
+  ! Explicit-shape dummies: the particle's values are then plain memory, not sections.
+  subroutine increments(self, a, t, dt, Lp, de, sp, ep, Fp, stp, k, why, pnewdt)
+    class(empm_umat_t), intent(in) :: self
+    type(umat_args_t), intent(inout) :: a
+    real(wp), intent(in) :: t, dt, Lp(3,3), de(6)
+    real(wp), intent(inout) :: sp(6), ep(6), Fp(3,3), stp(self%nstatv + NEXTRA)
+    integer, intent(in) :: k
+    integer, intent(out) :: why
+    real(wp), intent(out) :: pnewdt
+    procedure(umat_iface), pointer :: umat
+    real(wp) :: h, dsub(6), drot(3,3), F0(3,3), F1(3,3), sig(6), stran(6), dstran(6)
+    real(wp) :: s(6), e(6)
+    integer :: j, i, nsv
+    logical :: spin
+    call c_f_procpointer(self%fun, umat)
+    nsv = self%nstatv
+    h = dt / k
+    if (k == 1) then
+      dsub = de
+    else
+      dsub = strain_increment(h, Lp)
+    end if
+    s = sp; e = ep; F0 = Fp
+    do i = 1, nsv
+      a%statev(i) = stp(i)
+    end do
+    a%sse = stp(nsv + 1); a%spd = stp(nsv + 2); a%scd = stp(nsv + 3)
+    why = 0; pnewdt = 1.0_wp
+    call step_rotation(h, Lp, drot, spin)
+    do j = 1, k
+      if (spin) then
+        call rotate(drot, s)
+        if (self%uses_stran) call rotate(drot, e)
+      end if
+      if (self%uses_dfgrd) then
+        call advance(a%ntens, h, Lp, F0, F1)
+      else
+        F1 = F0
+      end if
+      call to_abaqus(a%ntens, s, 1.0_wp, sig)
+      call to_abaqus(a%ntens, e, 2.0_wp, stran)
+      call to_abaqus(a%ntens, dsub, 2.0_wp, dstran)
+      a%time = t + (j - 1) * h
+      a%dtime = h
+      pnewdt = 1.0e36_wp ! "no limit": a UMAT lowers it to ask for a smaller increment
+      call umat(sig, a%statev, a%ddsdde, a%sse, a%spd, a%scd, a%rpl, a%ddsddt, a%drplde, &
+        a%drpldt, stran, dstran, a%time, a%dtime, a%temp, a%dtemp, a%predef, a%dpred, &
+        a%cmname, a%ndi, a%nshr, a%ntens, a%nstatv, a%props, a%nprops, a%coords, drot, &
+        pnewdt, a%celent, F0, F1, a%noel, a%npt, a%layer, a%kspt, a%kstep, a%kinc, &
+        int(CMNAME_LEN, c_size_t))
+      why = verdict(a%statev(nsv + 1:nsv + NGUARD), int(a%ntens), sig, pnewdt)
+      if (why /= 0) return
+      call from_abaqus(a%ntens, sig, s)
+      e = e + dsub
+      F0 = F1
+    end do
+    sp = s; ep = e; Fp = F0
+    do i = 1, nsv
+      stp(i) = a%statev(i)
+    end do
+    stp(nsv + 1) = a%sse; stp(nsv + 2) = a%spd; stp(nsv + 3) = a%scd
+  end subroutine increments
 
   ! The step's rotation Q = (I − ½ΔtW)⁻¹(I + ½ΔtW), W = skew(L), with the formula of
   ! jaumann_rotate in empm_plasticity, which the native rate-form models use: the UMAT's stress
@@ -710,13 +849,15 @@ contains
     end if
   end subroutine from_abaqus
 
-  ! x is finite (neither Inf nor NaN), by its exponent bits: no floating-point comparison, so no
-  ! invalid-operation flag (trapped in Debug builds) for a NaN the UMAT returned.
-  elemental logical function finite(x)
+  ! 1 when x is Inf or NaN (its 11 exponent bits all set: the exponent field + 1 carries into
+  ! bit 11), else 0. By its bits: no floating-point comparison, so no invalid-operation flag
+  ! (trapped in Debug builds) for a NaN the UMAT returned, and no branch (a stress's values are
+  ! or-ed, then tested once).
+  elemental integer(int64) function nonfinite(x)
     real(wp), intent(in) :: x
     integer(int64), parameter :: EXPONENT_BITS = int(z'7FF0000000000000', int64)
-    finite = iand(transfer(x, 1_int64), EXPONENT_BITS) /= EXPONENT_BITS
-  end function finite
+    nonfinite = ishft(ishft(iand(transfer(x, 1_int64), EXPONENT_BITS), -52) + 1, -11)
+  end function nonfinite
 
   !> P-wave speed sqrt((λ + 2μ)/ρ) from the case's `E`/`nu` or `wave_modulus` [m/s].
   pure real(wp) function um_wave_speed(self, rho)
