@@ -5,6 +5,7 @@ program empm_main
   use empm_terminal, only: empm_exit
   use empm_error, only: EMPM_ERR_INTERRUPTED
   use empm_parallel, only: empm_set_threads
+  use empm_comm, only: empm_comm_t, empm_comm_world
   use empm_solver, only: empm_run_stats_t, empm_run_summary
   use empm_files, only: empm_mkdir_p
   use empm_posix, only: empm_ignore_sigxfsz, empm_catch_stop_signals, empm_stop_signal
@@ -22,6 +23,7 @@ program empm_main
   type(empm_bench_config_t) :: bcfg
   type(empm_bench_result_t) :: bres
   type(empm_run_stats_t) :: stats
+  type(empm_comm_t) :: comm
 
   nargs = command_argument_count()
   if (nargs == 0) then
@@ -66,20 +68,27 @@ program empm_main
     call empm_ignore_sigxfsz()
     ! Ctrl-C or a batch system's SIGTERM: a checkpoint and the results so far, then exit.
     call empm_catch_stop_signals()
+    ! Under mpirun the processes run the case together (a build with EMPM_USE_MPI; otherwise
+    ! each would run it alone): only the root prints, every process exits with the status.
+    comm = empm_comm_world()
     ! A verification case file also runs: its &verify group is the suite's, not the run's.
     call empm_run_case(case_file, out_file, written=written, err=err, extra_groups='verify', &
-                       stats=stats, restart=restart, auto_threads=auto)
+                       stats=stats, restart=restart, auto_threads=auto, comm=comm)
     ! The summary also for a run stopped by a guard (whenever the time loop ran).
-    if (stats%ran) write(output_unit, '(a)', iostat=ios) 'empm: '//empm_run_summary(stats)
+    if (stats%ran .and. comm%is_root()) &
+      write(output_unit, '(a)', iostat=ios) 'empm: '//empm_run_summary(stats)
     if (err%code == EMPM_ERR_INTERRUPTED) then
       ! As shells report a process ended by a signal: 128 + its number.
-      write(error_unit, '(a)') 'empm: '//err%message
+      if (comm%is_root()) write(error_unit, '(a)') 'empm: '//err%message
+      call comm%finish()
       call empm_exit(128 + empm_stop_signal())
     else if (err%code /= 0) then
-      write(error_unit, '(a)') 'empm: error: '//err%message
+      if (comm%is_root()) write(error_unit, '(a)') 'empm: error: '//err%message
+      call comm%finish()
       call empm_exit(err%code)
     end if
-    write(output_unit, '(a)', iostat=ios) 'empm: wrote '//written
+    if (comm%is_root()) write(output_unit, '(a)', iostat=ios) 'empm: wrote '//written
+    call comm%finish()
   case ('verify')
     manifest = 'verification/cases.txt'; outdir = 'reports'; quick = .false.
     allocate(patterns(nargs)); npat = 0
@@ -105,11 +114,16 @@ program empm_main
       write(error_unit, '(a)') 'empm: error: cannot create '//outdir//'/raw'
       call empm_exit(4)
     end if
-    call empm_verify_run(manifest, outdir, patterns(1:npat), quick, nfail, err)
+    ! Under mpirun every case runs on all the processes (a build with EMPM_USE_MPI).
+    comm = empm_comm_world()
+    call empm_verify_run(manifest, outdir, patterns(1:npat), quick, nfail, err, comm)
+    nfail = comm%max_int(nfail)
     if (err%code /= 0) then
-      write(error_unit, '(a)') 'empm: error: '//err%message
+      if (comm%is_root()) write(error_unit, '(a)') 'empm: error: '//err%message
+      call comm%finish()
       call empm_exit(err%code)
     end if
+    call comm%finish()
     if (nfail > 0) call empm_exit(5)
   case ('bench')
     i = 2

@@ -10,7 +10,8 @@
 !>     φ_I = Σ_p N_Ip V_p / h^d < θ,
 !>
 !> and it has no fixed dof (nor is a mirror plane's image node). Its value is extrapolated linearly from the nearest free, well-filled
-!> node J (Euclidean distance in grid steps, then the largest φ) and J's free neighbour one step
+!> node J (Euclidean distance in grid steps, then the largest φ, equal to 1e-12 relative
+!> counting as a tie that node order breaks) and J's free neighbour one step
 !> further into the body along each direction of the offset,
 !> v_I = (1 + Σ|o_d|) v_J − Σ |o_d| v_{J − sgn(o_d) e_d}, o = I − J (grid steps): linear fields
 !> stay exact, as in the extended B-splines of Höllig. The lumped system is the one of that
@@ -30,6 +31,7 @@ module empm_extension
 
   integer, parameter :: EXT_MAXST = 4 !! stencil entries per degenerate node (1 + ndim)
   integer, parameter :: REACH = 3     !! grid steps searched for a well-filled node
+  real(wp), parameter :: TIE = 1.0e-12_wp !! fills closer than this (relative) are equal
   real(wp), parameter :: EXT_THETA_DEFAULT = 0.1_wp !! default fill fraction (`&grid min_fill`)
 
   !> The degenerate nodes of the current basis and their extrapolation stencils.
@@ -112,7 +114,10 @@ contains
               K = grid%node_id(q)
               if (.not. usable(K)) cycle
               dist = sum((q - ijk)**2)
-              if (dist < dbest .or. (dist == dbest .and. vol(K) > best)) then
+              ! "Better filled" beyond round-off only: equally filled nodes (a symmetric
+              ! body) must not be told apart by the last bits of their sums, which depend on
+              ! the summation order (threads, processes); the first in node order wins.
+              if (dist < dbest .or. (dist == dbest .and. vol(K) > best + TIE * abs(best))) then
                 J = K; best = vol(K); dbest = dist
               end if
             end do

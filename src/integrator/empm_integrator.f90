@@ -188,6 +188,7 @@ contains
     if (stat%code /= 0) return
     call model%nodes%reset()
     call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
+    call model%comm%sum(model%nodes%mass)
     call extend_masses(self, model)
     model%nodes%vel = 0.0_wp ! no damping in this assembly
     call self%assemble_forces(model, model%t)
@@ -212,6 +213,7 @@ contains
     if (stat%code /= 0) return
     call model%nodes%reset()
     call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
+    call model%comm%sum(model%nodes%mass)
     call extend_masses(self, model)
     call self%assemble_forces(model, model%t)
     call nodal_divide_by_mass(model%nodes, model%nodes%force, model%nodes%acc)
@@ -242,11 +244,31 @@ contains
       call model%shape%eval_batch(model%grid, model%pts, model%basis, ibad, info)
     end if
     if (info /= 0) then
-      stat%code = STEP_SHAPE_FAILED; stat%detail = info; stat%particle = ibad
+      stat%code = STEP_SHAPE_FAILED; stat%detail = info; stat%particle = model%pts%id(ibad)
+      stat%rank = model%comm%rank; stat%local = ibad
     else if (present(ws)) then
       call ws%set_ranges(model%basis)
     end if
+    call agree_status(model, stat)
   end subroutine eval_basis
+
+  !> Every process takes the failure the serial run would report (that of the particle with
+  !> the smallest id), or none: the processes leave a step together, before its next
+  !> collective operation.
+  subroutine agree_status(model, stat)
+    type(empm_model_t), intent(in) :: model          !! simulation state (communicator)
+    type(empm_step_status_t), intent(inout) :: stat  !! this process's outcome in, the run's out
+    integer :: first, lowest, v(5)
+    if (.not. model%comm%parallel()) return
+    lowest = model%comm%min_int(merge(stat%particle, huge(1), stat%code /= 0))
+    first = model%comm%min_int(merge(model%comm%rank, model%comm%nranks, &
+                                     stat%code /= 0 .and. stat%particle == lowest))
+    if (first == model%comm%nranks) return
+    v = [stat%code, stat%detail, stat%particle, stat%rank, stat%local]
+    call model%comm%bcast_ints(v, first)
+    stat%code = v(1); stat%detail = v(2); stat%particle = v(3); stat%rank = v(4)
+    stat%local = v(5)
+  end subroutine agree_status
 
   !> After the nodal masses were accumulated on a new basis: mirror ghosts' masses go to their
   !> images; with the extension of nearly-empty nodes on ([[empm_extension]]), find them (their
@@ -260,6 +282,7 @@ contains
       if (nodes%ext%theta <= 0.0_wp) return
       nodes%vol = 0.0_wp
       call p2g_mass(model%basis, model%pts%vol, nodes%vol, self%p2g)
+      call model%comm%sum(nodes%vol)
       call nodes%find_degenerate(model%grid)
       if (nodes%ext%n > 0) call nodes%ext%gather_mass(nodes%mass)
     end associate
@@ -317,6 +340,7 @@ contains
         else
           call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom, self%p2g)
         end if
+        call model%comm%sum(nodes%mom)
       else
         call eval_basis(model, stat, tm, self%p2g, self%reeval)
         self%reeval = .false.
@@ -329,6 +353,8 @@ contains
           call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
                                  self%p2g)
         end if
+        call model%comm%sum(nodes%mass)
+        call model%comm%sum(nodes%mom)
         call extend_masses(self, model)
       end if
       call tm%lap(PHASE_P2G)
@@ -362,10 +388,12 @@ contains
                                                 model%pts%x(:, 1:np), self%bwork(:, 1:np))
     call p2g_body_force(model%basis, model%pts%m, g(1:d), self%bwork, use_b, model%nodes%force, &
                         self%p2g)
+    call model%comm%sum(model%nodes%force)
     if (model%loads%ntraction() > 0) then
       ! The tractions' nodal forces apart (for the residual's ‖f_ext‖), then added.
       self%tforce = 0.0_wp
       call p2g_tractions(model, t, self%tforce)
+      call model%comm%sum(self%tforce)
       model%nodes%force = model%nodes%force + self%tforce
     end if
     if (model%nodes%nset > 0) call model%nodes%compute_reactions(model%nodes%force)
@@ -678,6 +706,8 @@ contains
     integ%vs_mass = 0.0_wp; integ%vs_q = 0.0_wp
     call p2g_mass(model%basis, model%pts%m(1:np), integ%vs_mass, integ%p2g)
     call p2g_mass(model%basis, integ%vs_w(1:np), integ%vs_q, integ%p2g)
+    call model%comm%sum(integ%vs_mass)
+    call model%comm%sum(integ%vs_q)
     ! Mirror planes: the volumetric rate is even about the plane, so a ghost's share adds to its
     ! image and the ghost takes the image's value.
     call model%nodes%mirror_gather_even(integ%vs_mass)
@@ -777,10 +807,13 @@ contains
       end do
       !$omp end parallel do
       if (bad /= huge(1)) then
-        stat%code = STEP_MATERIAL_FAILED; stat%detail = im; stat%particle = bad
-        return
+        stat%code = STEP_MATERIAL_FAILED; stat%detail = im; stat%particle = model%pts%id(bad)
+        stat%rank = model%comm%rank; stat%local = bad
+        exit
       end if
     end do
+    call agree_status(model, stat)
+    if (stat%code /= 0) return
     model%diag_step = ctx%step; model%diag_fine = fine; model%diag_cmax = cm
   end subroutine stress_blocks
 

@@ -2,7 +2,8 @@
 !> command and callable from embedding codes.
 module empm_driver
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
-  use empm_error, only: empm_error_t, empm_raise_error, EMPM_OK, EMPM_ERR_INTERRUPTED
+  use empm_error, only: empm_error_t, empm_raise_error, EMPM_OK, EMPM_ERR_INTERRUPTED, &
+                        EMPM_ERR_INPUT
   use empm_case, only: empm_case_t
   use empm_input, only: empm_read_case
   use empm_model, only: empm_model_t
@@ -15,6 +16,9 @@ module empm_driver
   use empm_parallel, only: empm_cpu_sample_t, empm_cpu_sample, empm_threads_for_load, &
                            empm_max_threads, empm_set_threads, EMPM_OMP_MIN_PARTICLES
   use empm_strings, only: str
+  use empm_kinds, only: wp
+  use empm_comm, only: empm_comm_t
+  use empm_partition, only: empm_partition_particles, empm_gather_particles
   implicit none
   private
   public :: empm_run_case
@@ -62,7 +66,7 @@ contains
   !> empm_catch_stop_signals) ends the run after the current step with a checkpoint and the
   !> results so far (marked incomplete), error code EMPM_ERR_INTERRUPTED.
   subroutine empm_run_case(path, output, progress, written, err, extra_groups, stats, &
-                           initial_snapshot, restart, auto_threads)
+                           initial_snapshot, restart, auto_threads, comm)
     character(len=*), intent(in) :: path                !! case file
     character(len=*), intent(in), optional :: output    !! output HDF5 path override
     logical, intent(in), optional :: progress           !! progress on stderr (default on; false
@@ -84,6 +88,11 @@ contains
                                                         !! many as the cores other processes
                                                         !! leave idle over the set-up (at least
                                                         !! 0.2 s), at most the current number
+    type(empm_comm_t), intent(in), optional :: comm     !! the processes that run the case
+                                                        !! together (every one calls this with
+                                                        !! the same arguments; the root writes
+                                                        !! the results): docs/parallel.md.
+                                                        !! Default: this process alone
     type(empm_case_t) :: cs
     type(driver_hook_t) :: hook
     type(empm_solver_state_t) :: sst
@@ -104,10 +113,27 @@ contains
       if (len_trim(output) > 0) cs%output_file = trim(output)
     end if
     if (present(progress)) cs%run%progress = progress
-    if (present(auto_threads)) then
+    if (present(comm)) cs%model%comm = comm
+    resumed = .false.
+    if (present(restart)) resumed = len_trim(restart) > 0
+    if (cs%model%comm%parallel()) then
+      ! One thread per process unless OMP_NUM_THREADS or --threads say otherwise: the
+      ! processes already share the cores.
+      if (present(auto_threads)) then
+        if (auto_threads) call empm_set_threads(1)
+      end if
+      if (resumed .or. cs%run%checkpoint_every > 0 .or. cs%run%checkpoint_seconds > 0.0_wp) then
+        call e%set(EMPM_ERR_INPUT, path//': checkpoints (&output checkpoint_every, '// &
+          'checkpoint_seconds) and --restart are not available on several processes yet '// &
+          '(docs/parallel.md); run on one process for them')
+        call empm_raise_error(e, err); return
+      end if
+    else if (present(auto_threads)) then
       if (auto_threads) call choose_threads()
     end if
-    call empm_output_claim(cs%output_file, e)
+    ! The root claims the output for all (one file, one lock); its verdict is everyone's.
+    if (cs%model%comm%is_root()) call empm_output_claim(cs%output_file, e)
+    call agree_error(e)
     if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
     end if
@@ -122,12 +148,17 @@ contains
     hook%path = empm_checkpoint_path(cs%output_file)
     hook%prev = empm_checkpoint_path(cs%output_file, prev=.true.)
     hook%case_text = cs%text
-    resumed = .false.
-    if (present(restart)) resumed = len_trim(restart) > 0
+    if (cs%model%comm%parallel()) then
+      call empm_partition_particles(cs%model, e)
+      if (e%code /= EMPM_OK) then
+        call release(); call empm_raise_error(e, err); return
+      end if
+      call hist%locate_probes(cs%model%pts)
+    end if
     if (resumed) then
       call empm_checkpoint_read(trim(restart), cs%model, hist, sst, cs%text, warning, e)
       if (e%code /= EMPM_OK) then
-        call empm_output_release(cs%output_file)
+        call release()
         call empm_raise_error(e, err); return
       end if
       if (len(warning) > 0 .and. cs%run%progress) write(error_unit, '(a)') 'empm: note: '//warning
@@ -139,16 +170,25 @@ contains
     meta%case_file = path; meta%case_text = cs%text
     meta%shape = cs%shape_name; meta%integrator = cs%scheme_name
     meta%cfl = cs%run%cfl; meta%t_end = cs%run%t_end
-    if (e%code == EMPM_OK) then
-      call empm_write_results(cs%output_file, cs%model, hist, meta, .true., '', ew)
-    else
-      call empm_write_results(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
+    ! Several processes: the root gathers the particles and writes as a serial run would.
+    call empm_gather_particles(cs%model, hist, ew)
+    if (ew%code == EMPM_OK .and. cs%model%comm%is_root()) then
+      if (e%code == EMPM_OK) then
+        call empm_write_results(cs%output_file, cs%model, hist, meta, .true., '', ew)
+      else
+        call empm_write_results(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
+      end if
     end if
-    call empm_output_release(cs%output_file)
+    call agree_error(ew)
+    call release()
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then
       ! The guard's error, with its location fields; the message says where the state went.
-      if (e%code == EMPM_ERR_INTERRUPTED .and. ew%code == EMPM_OK) then
+      if (e%code == EMPM_ERR_INTERRUPTED .and. ew%code == EMPM_OK .and. &
+          cs%model%comm%parallel()) then
+        e%message = e%message//'; results so far written to '//cs%output_file// &
+          ', marked incomplete'
+      else if (e%code == EMPM_ERR_INTERRUPTED .and. ew%code == EMPM_OK) then
         e%message = e%message//' to '//hook%path//'; results so far written to '// &
           cs%output_file//', marked incomplete; continue with --restart '//hook%path
       else if (ew%code == EMPM_OK) then
@@ -163,6 +203,27 @@ contains
     end if
 
   contains
+
+    ! The root's error (output claim, writing) on every process.
+    subroutine agree_error(ec)
+      type(empm_error_t), intent(inout) :: ec
+      integer :: v(1)
+      character(len=:), allocatable :: text
+      if (.not. cs%model%comm%parallel()) return
+      v(1) = ec%code
+      call cs%model%comm%bcast_ints(v, 0)
+      text = ''
+      if (cs%model%comm%is_root() .and. allocated(ec%message)) text = ec%message
+      call cs%model%comm%bcast_text(text, 0)
+      if (.not. cs%model%comm%is_root()) then
+        ec%code = v(1); ec%message = text
+      end if
+    end subroutine agree_error
+
+    ! The root releases the output it claimed.
+    subroutine release()
+      if (cs%model%comm%is_root()) call empm_output_release(cs%output_file)
+    end subroutine release
 
     ! Threads for a run that can use them (EMPM_OMP_MIN_PARTICLES or more): the cores other
     ! processes left idle since the start of the set-up, measured over at least 0.2 s.

@@ -100,6 +100,7 @@ contains
     call h5_attr(fid, 'ndim', model%grid%ndim, ierr)
     call h5_attr(fid, 'time', model%t, ierr)
     call h5_attr(fid, 'steps', model%step, ierr)
+    call h5_attr(fid, 'mpi_ranks', model%comm%nranks, ierr)
 
     call h5_group(fid, 'grid', g, ierr)
     call h5_attr(g, 'origin', model%grid%origin(1:model%grid%ndim), ierr)

@@ -32,6 +32,8 @@ module empm_history
     integer :: nprobe = 0                    !! number of probes
     character(len=64), allocatable :: probe_name(:)  !! probe names (nprobe)
     integer, allocatable :: probe_particle(:)        !! particle followed by each probe
+    integer, allocatable :: probe_local(:)           !! its index on this process (0: held by
+                                                     !! another; [[history_locate_probes]])
     real(wp), allocatable :: t(:)            !! sample times (nt) [s]
     real(wp), allocatable :: kinetic(:)      !! kinetic energy (nt) [J]
     real(wp), allocatable :: strain(:)       !! stored elastic energy (nt) [J]
@@ -54,6 +56,7 @@ module empm_history
     procedure :: init => history_init
     procedure :: add_sample => history_add_sample
     procedure :: add_snapshot => history_add_snapshot
+    procedure :: locate_probes => history_locate_probes
   end type empm_history_t
 
 contains
@@ -74,13 +77,13 @@ contains
     n = size(particles); c = max(capacity, 16)
     self%nt = 0; self%nprobe = n; self%nsnap = 0
     if (allocated(self%t)) deallocate(self%t, self%kinetic, self%strain, self%gravity, &
-      self%px, self%pv, self%ps, self%probe_name, self%probe_particle)
+      self%px, self%pv, self%ps, self%probe_name, self%probe_particle, self%probe_local)
     if (allocated(self%snap)) deallocate(self%snap)
     if (allocated(self%residual)) deallocate(self%residual)
     if (allocated(self%set_name)) deallocate(self%set_name, self%reaction, self%set_disp)
     self%tracked = .false.; self%nset = 0
-    allocate(self%probe_name(n), self%probe_particle(n))
-    self%probe_name = names; self%probe_particle = particles
+    allocate(self%probe_name(n), self%probe_particle(n), self%probe_local(n))
+    self%probe_name = names; self%probe_particle = particles; self%probe_local = particles
     allocate(self%t(c), self%kinetic(c), self%strain(c), self%gravity(c), &
       self%px(ndim, n, c), self%pv(ndim, n, c), self%ps(6, n, c), self%snap(max(nsnap_max, 1)), &
       stat=stat, errmsg=msg)
@@ -99,7 +102,7 @@ contains
     real(wp), intent(in) :: egrav                !! gravitational potential [J]
     type(empm_particles_t), intent(in) :: pts    !! particles (probe values)
     type(empm_model_t), intent(in), optional :: model !! model (residual, reactions)
-    integer :: k, p, nd
+    integer :: k, p, nd, q
     if (present(model)) then
       ! Tracking starts with the first sample (a model tracked only later is not recorded).
       if (model%track .and. .not. self%tracked .and. self%nt == 0) then
@@ -113,10 +116,21 @@ contains
     k = self%nt + 1; self%nt = k
     self%t(k) = t; self%kinetic(k) = ekin; self%strain(k) = estrain; self%gravity(k) = egrav
     do p = 1, self%nprobe
-      self%px(:, p, k) = pts%x(:, self%probe_particle(p))
-      self%pv(:, p, k) = pts%v(:, self%probe_particle(p))
-      self%ps(:, p, k) = pts%stress(:, self%probe_particle(p))
+      q = self%probe_local(p)
+      if (q > 0) then
+        self%px(:, p, k) = pts%x(:, q)
+        self%pv(:, p, k) = pts%v(:, q)
+        self%ps(:, p, k) = pts%stress(:, q)
+      else
+        self%px(:, p, k) = 0.0_wp; self%pv(:, p, k) = 0.0_wp; self%ps(:, p, k) = 0.0_wp
+      end if
     end do
+    if (present(model) .and. self%nprobe > 0) then
+      ! One process holds each probe's particle; the others add zeros.
+      call model%comm%sum(self%px(:, :, k))
+      call model%comm%sum(self%pv(:, :, k))
+      call model%comm%sum(self%ps(:, :, k))
+    end if
     if (self%tracked .and. present(model)) then
       self%residual(k) = model%residual
       do p = 1, self%nset
@@ -125,6 +139,20 @@ contains
       end do
     end if
   end subroutine history_add_sample
+
+  !> Find each probe's particle among those this process holds (by id, after the particles
+  !> were shared among processes); 0 where another process holds it.
+  subroutine history_locate_probes(self, pts)
+    class(empm_history_t), intent(inout) :: self !! record
+    type(empm_particles_t), intent(in) :: pts    !! this process's particles
+    integer :: p, q
+    self%probe_local = 0
+    do q = 1, pts%np
+      do p = 1, self%nprobe
+        if (pts%id(q) == self%probe_particle(p)) self%probe_local(p) = q
+      end do
+    end do
+  end subroutine history_locate_probes
 
   subroutine grow(self)
     type(empm_history_t), intent(inout) :: self

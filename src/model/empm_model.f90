@@ -11,6 +11,7 @@ module empm_model
   use empm_shape, only: empm_shape_t, empm_basis_t
   use empm_material, only: empm_material_t, STATE_NAME_LEN
   use empm_loads, only: empm_loads_t
+  use empm_comm, only: empm_comm_t
   implicit none
   private
   public :: empm_model_t, empm_material_slot_t, empm_step_status_t
@@ -30,7 +31,10 @@ module empm_model
   type :: empm_step_status_t
     integer :: code = STEP_OK   !! STEP_* code
     integer :: detail = 0       !! SHAPE_* code, or the failing particle's material index
-    integer :: particle = 0     !! offending particle, 0 if none
+    integer :: particle = 0     !! offending particle (its id: number in generation order),
+                                !! 0 if none
+    integer :: rank = 0         !! the process that holds it
+    integer :: local = 0        !! its index there
   end type empm_step_status_t
 
   !> One simulation.
@@ -42,6 +46,9 @@ module empm_model
     class(empm_shape_t), allocatable :: shape           !! shape-function family
     type(empm_material_slot_t), allocatable :: mats(:)  !! materials, indexed by pts%mat
     type(empm_loads_t) :: loads                         !! external loads
+    type(empm_comm_t) :: comm                           !! the processes sharing the run: each
+                                                        !! holds its particles, all the grid
+                                                        !! (docs/parallel.md); serial default
     integer, allocatable :: run_first(:)                !! particle runs with one material: first
     integer, allocatable :: run_last(:)                 !! ... last particle of the run
     real(wp) :: t = 0.0_wp                              !! current time [s]
@@ -68,6 +75,7 @@ module empm_model
                                                         !! (`max_wave_speed`) [m/s]
   contains
     procedure :: finalize_setup => model_finalize_setup
+    procedure :: set_runs => model_set_runs
   end type empm_model_t
 
 contains
@@ -83,45 +91,19 @@ contains
     class(empm_model_t), intent(inout) :: self          !! model
     type(empm_error_t), intent(inout), optional :: err  !! set-up error, if present
     type(empm_error_t) :: e
-    integer :: p, nrun, np, nsmax, im, r, ns, st
-    character(len=256) :: msg
+    integer :: nrun, np, nsmax, im, r, ns
     np = self%pts%np
     ! Keep constraints set earlier with nodes%fix_box.
     if (.not. allocated(self%nodes%mass) .or. self%nodes%nnode /= self%grid%nnode) &
       call self%nodes%alloc(self%grid, e)
-    if (e%code == 0) call self%basis%alloc(self%grid%ndim, self%shape%max_nodes(self%grid), np, &
-                                           self%shape%layout(self%grid), e)
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
-    ! Contiguous runs of particles sharing a material: one batched update per run.
-    nrun = 0
-    do p = 1, np
-      if (p == 1) then
-        nrun = nrun + 1
-      else if (self%pts%mat(p) /= self%pts%mat(p - 1)) then
-        nrun = nrun + 1
-      end if
-    end do
-    if (allocated(self%run_first)) deallocate(self%run_first)
-    if (allocated(self%run_last)) deallocate(self%run_last)
-    st = 0; msg = ''
-    allocate(self%run_first(nrun), self%run_last(nrun), stat=st, errmsg=msg)
-    if (st /= 0) then
-      call empm_raise_error(empm_alloc_error('material runs ('//str(nrun)//')', &
-        8_int64 * nrun, trim(msg)), err)
-      return
+    call self%set_runs(e)
+    if (e%code /= 0) then
+      call empm_raise_error(e, err); return
     end if
-    nrun = 0
-    do p = 1, np
-      if (p == 1) then
-        nrun = nrun + 1; self%run_first(nrun) = p
-      else if (self%pts%mat(p) /= self%pts%mat(p - 1)) then
-        self%run_last(nrun) = p - 1
-        nrun = nrun + 1; self%run_first(nrun) = p
-      end if
-    end do
-    if (nrun > 0) self%run_last(nrun) = np
+    nrun = size(self%run_first)
     ! Nodes holding less than this are empty: dividing by their mass would amplify round-off.
     if (np > 0) then
       self%nodes%mass_tol = 1.0e-10_wp * minval(self%pts%m(1:np))
@@ -164,6 +146,50 @@ contains
         self%pts%state(1:ns, self%run_first(r):self%run_last(r)))
     end do
   end subroutine model_finalize_setup
+
+  !> The particles' basis storage and material runs (contiguous particles sharing a material:
+  !> one batched update per run), for the particles the model holds now; set-up, and again
+  !> when a process has taken its share of them.
+  subroutine model_set_runs(self, err)
+    class(empm_model_t), intent(inout) :: self          !! model
+    type(empm_error_t), intent(inout), optional :: err  !! allocation failure, if present
+    type(empm_error_t) :: e
+    integer :: p, nrun, np, st
+    character(len=256) :: msg
+    np = self%pts%np
+    call self%basis%alloc(self%grid%ndim, self%shape%max_nodes(self%grid), np, &
+                          self%shape%layout(self%grid), e)
+    if (e%code /= 0) then
+      call empm_raise_error(e, err); return
+    end if
+    nrun = 0
+    do p = 1, np
+      if (p == 1) then
+        nrun = nrun + 1
+      else if (self%pts%mat(p) /= self%pts%mat(p - 1)) then
+        nrun = nrun + 1
+      end if
+    end do
+    if (allocated(self%run_first)) deallocate(self%run_first)
+    if (allocated(self%run_last)) deallocate(self%run_last)
+    st = 0; msg = ''
+    allocate(self%run_first(nrun), self%run_last(nrun), stat=st, errmsg=msg)
+    if (st /= 0) then
+      call empm_raise_error(empm_alloc_error('material runs ('//str(nrun)//')', &
+        8_int64 * nrun, trim(msg)), err)
+      return
+    end if
+    nrun = 0
+    do p = 1, np
+      if (p == 1) then
+        nrun = nrun + 1; self%run_first(nrun) = p
+      else if (self%pts%mat(p) /= self%pts%mat(p - 1)) then
+        self%run_last(nrun) = p - 1
+        nrun = nrun + 1; self%run_first(nrun) = p
+      end if
+    end do
+    if (nrun > 0) self%run_last(nrun) = np
+  end subroutine model_set_runs
 
   !> A material's state variables must have as many names as `nstate`, each made of letters,
   !> digits and '_' (they name HDF5 datasets and XDMF attributes), without repeats.

@@ -43,6 +43,9 @@ module empm_particles
     real(wp), allocatable :: lam_old_prev(:,:) !! this, what that evaluation started from
                                             !! ([[particles_rewind_shape_state]])
     integer, allocatable :: mat(:)          !! material index (np)
+    integer, allocatable :: id(:)           !! the particle's number in generation order (np):
+                                            !! its place in the output whichever process
+                                            !! holds it (docs/parallel.md)
     integer :: nstate = 0                   !! state variables per particle (rows of `state`)
     real(wp), allocatable :: state(:,:)     !! materials' state variables (nstate, np)
   contains
@@ -52,6 +55,10 @@ module empm_particles
     procedure :: copy_state_from => particles_copy_state
     procedure :: rewind_shape_state => particles_rewind_shape_state
     procedure :: material_fields_fine => particles_material_fields_fine
+    procedure :: row_size => particles_row_size
+    procedure :: pack_rows => particles_pack_rows
+    procedure :: set_from_rows => particles_set_from_rows
+    procedure :: keep => particles_keep
   end type empm_particles_t
 
 contains
@@ -106,11 +113,11 @@ contains
       self%m(n), self%vol(n), self%vol0(n), self%rho(n), self%stress(6, n), self%strain(6, n), &
       self%F(3, 3, n), self%lp(ndim, n), self%lam(ndim, n), &
       self%lam_old(ndim, n), self%lam_prev(ndim, n), self%lam_old_prev(ndim, n), self%mat(n), &
-      self%state(ns, n), stat=st, errmsg=msg)
+      self%id(n), self%state(ns, n), stat=st, errmsg=msg)
     if (st /= 0) then
       call release(self)
       ! 10 vectors, 4 scalars, 2 Voigt tensors, F and the state in reals; the material index.
-      bytes = int(n, int64) * (8_int64 * (10 * ndim + 4 + 12 + 9 + int(ns, int64)) + 4_int64)
+      bytes = int(n, int64) * (8_int64 * (10 * ndim + 4 + 12 + 9 + int(ns, int64)) + 8_int64)
       call empm_raise_error(empm_alloc_error('particle storage ('//str(n)//' particles)', &
         bytes, trim(msg)), err)
       return
@@ -162,6 +169,7 @@ contains
     if (allocated(self%lam_prev)) deallocate(self%lam_prev)
     if (allocated(self%lam_old_prev)) deallocate(self%lam_old_prev)
     if (allocated(self%mat)) deallocate(self%mat)
+    if (allocated(self%id)) deallocate(self%id)
     if (allocated(self%state)) deallocate(self%state)
   end subroutine release
 
@@ -207,6 +215,7 @@ contains
     self%lp(:, n) = lp(1:d); self%lam(:, n) = 0.0_wp; self%lam_old(:, n) = huge(1.0_wp)
     self%lam_prev(:, n) = 0.0_wp; self%lam_old_prev(:, n) = huge(1.0_wp)
     self%mat(n) = mat
+    self%id(n) = n
     self%state(:, n) = 0.0_wp
   end subroutine particles_append
 
@@ -234,6 +243,7 @@ contains
     self%lam_prev(:, 1:n) = src%lam_prev(:, 1:n)
     self%lam_old_prev(:, 1:n) = src%lam_old_prev(:, 1:n)
     self%mat(1:n) = src%mat(1:n)
+    self%id(1:n) = src%id(1:n)
   end subroutine particles_copy_state
 
   !> Put the shape state (the LME multipliers) back to what the last basis evaluation started
@@ -245,6 +255,95 @@ contains
     self%lam(:, 1:n) = self%lam_prev(:, 1:n)
     self%lam_old(:, 1:n) = self%lam_old_prev(:, 1:n)
   end subroutine particles_rewind_shape_state
+
+  !> Number of reals that hold one particle in a row ([[particles_pack_rows]]).
+  pure integer function particles_row_size(self) result(m)
+    class(empm_particles_t), intent(in) :: self !! particles
+    m = 10 * self%ndim + 4 + 12 + 9 + 2 + self%nstate
+  end function particles_row_size
+
+  !> rows(:, k) = every field of particle idx(k), as reals (the material index and the id are
+  !> exact in a real): what moves a particle between processes or gathers them for output.
+  pure subroutine particles_pack_rows(self, idx, rows)
+    class(empm_particles_t), intent(in) :: self    !! particles
+    integer, intent(in) :: idx(:)                  !! particles to pack
+    real(wp), intent(out) :: rows(:,:)             !! (row_size, >= size(idx))
+    integer :: k, p, d, o
+    d = self%ndim
+    do k = 1, size(idx)
+      p = idx(k)
+      rows(1:d, k) = self%x(:, p); rows(d + 1:2 * d, k) = self%x0(:, p)
+      rows(2 * d + 1:3 * d, k) = self%v(:, p); rows(3 * d + 1:4 * d, k) = self%a(:, p)
+      rows(4 * d + 1:5 * d, k) = self%dx(:, p); rows(5 * d + 1:6 * d, k) = self%lp(:, p)
+      rows(6 * d + 1:7 * d, k) = self%lam(:, p); rows(7 * d + 1:8 * d, k) = self%lam_old(:, p)
+      rows(8 * d + 1:9 * d, k) = self%lam_prev(:, p)
+      rows(9 * d + 1:10 * d, k) = self%lam_old_prev(:, p)
+      o = 10 * d
+      rows(o + 1, k) = self%m(p); rows(o + 2, k) = self%vol(p)
+      rows(o + 3, k) = self%vol0(p); rows(o + 4, k) = self%rho(p)
+      rows(o + 5:o + 10, k) = self%stress(:, p); rows(o + 11:o + 16, k) = self%strain(:, p)
+      rows(o + 17:o + 25, k) = reshape(self%F(:, :, p), [9])
+      rows(o + 26, k) = real(self%mat(p), wp); rows(o + 27, k) = real(self%id(p), wp)
+      rows(o + 28:o + 27 + self%nstate, k) = self%state(:, p)
+    end do
+  end subroutine particles_pack_rows
+
+  !> Make the set the n particles of `rows` ([[particles_pack_rows]]), in that order; storage
+  !> for exactly n. Allocation failures as in [[particles_alloc]].
+  subroutine particles_set_from_rows(self, ndim, nstate, rows, n, err)
+    class(empm_particles_t), intent(inout) :: self     !! particles (replaced)
+    integer, intent(in) :: ndim                        !! spatial dimension
+    integer, intent(in) :: nstate                      !! state variables per particle
+    real(wp), intent(in) :: rows(:,:)                  !! packed particles (row_size, >= n)
+    integer, intent(in) :: n                           !! number of particles
+    type(empm_error_t), intent(inout), optional :: err !! allocation failure, if present
+    type(empm_error_t) :: e
+    integer :: k, d, o
+    call self%alloc(ndim, n, nstate, e)
+    if (e%code /= 0) then
+      call empm_raise_error(e, err); return
+    end if
+    d = ndim; o = 10 * d
+    do k = 1, n
+      self%x(:, k) = rows(1:d, k); self%x0(:, k) = rows(d + 1:2 * d, k)
+      self%v(:, k) = rows(2 * d + 1:3 * d, k); self%a(:, k) = rows(3 * d + 1:4 * d, k)
+      self%dx(:, k) = rows(4 * d + 1:5 * d, k); self%lp(:, k) = rows(5 * d + 1:6 * d, k)
+      self%lam(:, k) = rows(6 * d + 1:7 * d, k); self%lam_old(:, k) = rows(7 * d + 1:8 * d, k)
+      self%lam_prev(:, k) = rows(8 * d + 1:9 * d, k)
+      self%lam_old_prev(:, k) = rows(9 * d + 1:10 * d, k)
+      self%m(k) = rows(o + 1, k); self%vol(k) = rows(o + 2, k)
+      self%vol0(k) = rows(o + 3, k); self%rho(k) = rows(o + 4, k)
+      self%stress(:, k) = rows(o + 5:o + 10, k); self%strain(:, k) = rows(o + 11:o + 16, k)
+      self%F(:, :, k) = reshape(rows(o + 17:o + 25, k), [3, 3])
+      self%mat(k) = nint(rows(o + 26, k)); self%id(k) = nint(rows(o + 27, k))
+      self%state(:, k) = rows(o + 28:o + 27 + nstate, k)
+    end do
+    self%np = n
+  end subroutine particles_set_from_rows
+
+  !> Keep particles idx(1), idx(2), ... (increasing), in that order, as particles 1, 2, ...;
+  !> the others are dropped (the storage keeps its size).
+  subroutine particles_keep(self, idx)
+    class(empm_particles_t), intent(inout) :: self !! particles
+    integer, intent(in) :: idx(:)                  !! particles to keep, increasing
+    integer :: k, p
+    do k = 1, size(idx)
+      p = idx(k)
+      if (p == k) cycle
+      self%x(:, k) = self%x(:, p); self%x0(:, k) = self%x0(:, p)
+      self%v(:, k) = self%v(:, p); self%a(:, k) = self%a(:, p); self%dx(:, k) = self%dx(:, p)
+      self%m(k) = self%m(p); self%vol(k) = self%vol(p); self%vol0(k) = self%vol0(p)
+      self%rho(k) = self%rho(p)
+      self%stress(:, k) = self%stress(:, p); self%strain(:, k) = self%strain(:, p)
+      self%F(:, :, k) = self%F(:, :, p)
+      self%lp(:, k) = self%lp(:, p); self%lam(:, k) = self%lam(:, p)
+      self%lam_old(:, k) = self%lam_old(:, p); self%lam_prev(:, k) = self%lam_prev(:, p)
+      self%lam_old_prev(:, k) = self%lam_old_prev(:, p)
+      self%mat(k) = self%mat(p); self%id(k) = self%id(p)
+      if (self%nstate > 0) self%state(:, k) = self%state(:, p)
+    end do
+    self%np = size(idx)
+  end subroutine particles_keep
 
   subroutine move_alloc_all(from, to)
     type(empm_particles_t), intent(inout) :: from
@@ -262,6 +361,7 @@ contains
     call move_alloc(from%lam_prev, to%lam_prev)
     call move_alloc(from%lam_old_prev, to%lam_old_prev)
     call move_alloc(from%mat, to%mat)
+    call move_alloc(from%id, to%id)
     to%nstate = from%nstate
     call move_alloc(from%state, to%state)
   end subroutine move_alloc_all

@@ -133,7 +133,9 @@ contains
         model%pts%stress(:, i0:i1), model%pts%state(:, i0:i1))
       cmax = max(cmax, c)
     end do
-    dt = model%grid%hmin() / cmax
+    cmax = model%comm%max_real(cmax)
+    dt = huge(1.0_wp) ! no particle anywhere (a process may hold none)
+    if (cmax > 0.0_wp) dt = model%grid%hmin() / cmax
   end function empm_stable_dt
 
   !> Kinetic energy, stored (elastic) energy and gravitational potential of the particles.
@@ -158,7 +160,19 @@ contains
         psi(i0:i1))
     end do
     estrain = stored_energy(model, psi)
+    call sum_energies(model, ekin, estrain, egrav)
   end subroutine empm_energies
+
+  ! The energies of all the processes' particles (each process summed its own).
+  subroutine sum_energies(model, ekin, estr, egrav)
+    type(empm_model_t), intent(in) :: model
+    real(wp), intent(inout) :: ekin, estr, egrav
+    real(wp) :: e(3)
+    if (.not. model%comm%parallel()) return
+    e = [ekin, estr, egrav]
+    call model%comm%sum(e)
+    ekin = e(1); estr = e(2); egrav = e(3)
+  end subroutine sum_energies
 
   !> Run `model` with `integ` until `cfg%t_end`. Records energies, probes and snapshots in
   !> `hist`. On a tripped guard the model is restored to the last good state and the error
@@ -259,7 +273,7 @@ contains
       st%dt_min = huge(1.0_wp)
       call skip_past_snapshots()
     end if
-    show = cfg%progress
+    show = cfg%progress .and. model%comm%is_root()
     tty = .false.
     if (show) tty = stderr_is_terminal()
     ! Plain lines (logs, pipes) are written when t passes the next tenth of the run.
@@ -277,7 +291,10 @@ contains
       end if
       ! The last stress update gave c_max while its blocks were in cache (fine values only:
       ! with a failed screen the guards have stopped the run); the same maximum.
-      if (model%diag_step == model%step .and. model%diag_fine .and. model%diag_cmax > 0.0_wp) then
+      if (model%comm%parallel()) then
+        dt_stable = empm_stable_dt(model)
+      else if (model%diag_step == model%step .and. model%diag_fine .and. &
+               model%diag_cmax > 0.0_wp) then
         dt_stable = model%grid%hmin() / model%diag_cmax
       else
         dt_stable = empm_stable_dt(model)
@@ -311,7 +328,11 @@ contains
       nrep = nrep + 1; dts(nrep) = dt
       model%step = model%step + 1
       if (stat%code /= STEP_OK) then
-        msg = describe_status(stat)
+        ! The process that holds the particle says why (its material knows); the others
+        ! take its words.
+        msg = ''
+        if (model%comm%rank == stat%rank) msg = describe_status(stat)
+        call model%comm%bcast_text(msg, stat%rank)
         call restore(); call fail(msg, stat%particle); return
       end if
       model%t = model%t + dt
@@ -320,8 +341,14 @@ contains
       ! runs only when it fails.
       sample = mod(model%step, cfg%history_every) == 0 .or. model%t >= cfg%t_end
       call screen_step(model, sample, suspect, ekin, egrav, estr, summed)
+      if (model%comm%parallel()) then
+        suspect = model%comm%any_true(suspect)
+        summed = .not. model%comm%any_true(.not. summed)
+        if (summed) call sum_energies(model, ekin, estr, egrav)
+      end if
       if (suspect) then
-        msg = empm_check_guards(model)
+        msg = empm_check_guards(model, k)
+        msg = first_problem(msg, k)
         if (len(msg) > 0) then
           call restore(); call fail(msg); return
         end if
@@ -338,8 +365,10 @@ contains
       call skip_past_snapshots()
       if (show) call progress()
       if (present(hook)) then
-        sig = hook%stop_requested()
-        if (checkpoint_due() .or. sig /= 0) then
+        sig = model%comm%max_int(hook%stop_requested())
+        ! No checkpoints on several processes yet (docs/parallel.md): the driver refuses
+        ! their keys, and a stop request ends the run with its results only.
+        if (.not. model%comm%parallel() .and. (checkpoint_due() .or. sig /= 0)) then
           call checkpoint(e)
           if (e%code /= 0) then
             if (show .and. tty) write(error_unit, '(a)') ''
@@ -349,9 +378,15 @@ contains
         if (sig /= 0) then
           if (show .and. tty) write(error_unit, '(a)') ''
           call finish_stats()
-          call empm_raise(EMPM_ERR_INTERRUPTED, 'stopped by '//signal_name(sig)// &
-            ' after step '//str(model%step)//' at t = '//str(model%t)// &
-            ' s: checkpoint written', err)
+          if (model%comm%parallel()) then
+            call empm_raise(EMPM_ERR_INTERRUPTED, 'stopped by '//signal_name(sig)// &
+              ' after step '//str(model%step)//' at t = '//str(model%t)// &
+              ' s (no checkpoint: not available on several processes yet)', err)
+          else
+            call empm_raise(EMPM_ERR_INTERRUPTED, 'stopped by '//signal_name(sig)// &
+              ' after step '//str(model%step)//' at t = '//str(model%t)// &
+              ' s: checkpoint written', err)
+          end if
           return
         end if
       end if
@@ -431,8 +466,8 @@ contains
       g0 = model%loads%gravity_at(t_prev); g1 = model%loads%gravity_at(model%t)
       if (all(g0 == g1) .or. .not. ramping) return
       d = model%grid%ndim; np = model%pts%np
-      st%work_gravity = st%work_gravity - sum(model%pts%m(1:np) * matmul(g1(1:d) - g0(1:d), &
-        0.5_wp * (xprev(:, 1:np) + model%pts%x(:, 1:np))))
+      st%work_gravity = st%work_gravity - model%comm%sum_real(sum(model%pts%m(1:np) * &
+        matmul(g1(1:d) - g0(1:d), 0.5_wp * (xprev(:, 1:np) + model%pts%x(:, 1:np)))))
     end subroutine add_gravity_work
 
     ! The statistics of the run so far (the model holds the last good state).
@@ -516,11 +551,28 @@ contains
       flush(error_unit)
     end subroutine progress
 
+    ! The problem the serial run would report, on every process: the particle with the
+    ! smallest id (`id`, huge(1) for a nodal one, which every process finds alike).
+    function first_problem(mine, id) result(text)
+      character(len=*), intent(in) :: mine
+      integer, intent(in) :: id
+      character(len=:), allocatable :: text
+      integer :: first, lowest
+      text = mine
+      if (.not. model%comm%parallel()) return
+      lowest = model%comm%min_int(merge(id, huge(1), len(mine) > 0))
+      if (lowest == huge(1) .and. model%comm%min_int(len(mine)) > 0) return ! nodal: alike
+      first = model%comm%min_int(merge(model%comm%rank, model%comm%nranks, &
+                                       len(mine) > 0 .and. id == lowest))
+      if (first == model%comm%nranks) return
+      call model%comm%bcast_text(text, first)
+    end function first_problem
+
     function describe_status(s) result(text)
       type(empm_step_status_t), intent(in) :: s
       character(len=:), allocatable :: text
       integer :: p
-      p = max(1, min(s%particle, model%pts%np))
+      p = max(1, min(s%local, model%pts%np))
       if (s%code == STEP_SHAPE_FAILED) then
         text = 'step '//str(model%step)//': shape functions failed at particle '// &
           str(s%particle)//' at x = '//vec(model%pts%x(:, p))//': '//shape_status_text(s%detail)
@@ -705,11 +757,14 @@ contains
   !> Check particle and nodal fields after a step (state variables included: they must stay
   !> finite); returns '' when all is well, otherwise a message naming the step, the particle or
   !> node and the quantity.
-  function empm_check_guards(model) result(msg)
+  function empm_check_guards(model, where) result(msg)
     type(empm_model_t), intent(in) :: model !! simulation state
+    integer, intent(out), optional :: where !! id of the particle it names; huge(1) for a node
+                                            !! or no problem
     character(len=:), allocatable :: msg    !! '' or the first problem found
     integer :: p, I
     msg = ''
+    if (present(where)) where = huge(1)
     associate (pts => model%pts)
       do p = 1, pts%np
         if (.not. all(ieee_is_finite(pts%x(:, p)))) then
@@ -730,12 +785,14 @@ contains
           msg = 'non-finite or non-positive volume'
         end if
         if (len(msg) > 0) then
-          msg = 'step '//str(model%step)//': '//msg//' at particle '//str(p)
+          msg = 'step '//str(model%step)//': '//msg//' at particle '//str(model%pts%id(p))
+          if (present(where)) where = model%pts%id(p)
           return
         end if
         if (.not. model%grid%inside(pts%x(:, p))) then
-          msg = 'step '//str(model%step)//': particle '//str(p)//' left the grid: x = '// &
-            vec(pts%x(:, p))
+          msg = 'step '//str(model%step)//': particle '//str(model%pts%id(p))// &
+            ' left the grid: x = '//vec(pts%x(:, p))
+          if (present(where)) where = model%pts%id(p)
           return
         end if
         ! The ghost side of a mirror plane stands for the body's image: no particle may enter it.
@@ -743,8 +800,10 @@ contains
           if (sign(1.0_wp, real(model%nodes%plane_side(I), wp)) * (pts%x(abs(model%nodes% &
               plane_side(I)), p) - model%nodes%plane_at(I)) > &
               1.0e-9_wp * model%grid%h(abs(model%nodes%plane_side(I)))) then
-            msg = 'step '//str(model%step)//': particle '//str(p)//' crossed the mirror plane '// &
-              'at '//str(model%nodes%plane_at(I))//' m: x = '//vec(pts%x(:, p))
+            msg = 'step '//str(model%step)//': particle '//str(model%pts%id(p))// &
+              ' crossed the mirror plane at '//str(model%nodes%plane_at(I))//' m: x = '// &
+              vec(pts%x(:, p))
+            if (present(where)) where = model%pts%id(p)
             return
           end if
         end do

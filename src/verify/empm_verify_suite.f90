@@ -14,6 +14,8 @@ module empm_verify_suite
   use empm_input, only: empm_read_case
   use empm_history, only: empm_history_t
   use empm_solver, only: empm_solve
+  use empm_comm, only: empm_comm_t
+  use empm_partition, only: empm_partition_particles, empm_gather_particles
   use empm_output, only: empm_write_results, empm_output_meta_t
   use empm_verify_spec, only: empm_verify_spec_t, empm_read_verify_spec
   use empm_verify_bench, only: empm_bench_t, bench_known
@@ -60,13 +62,16 @@ contains
   !> starts a comment). Only runs whose id matches one of `patterns` run (all if none).
   !> `quick` runs only the first `quick_levels` levels of convergence studies and skips
   !> studies marked `quick = .false.`. Results go to `outdir`/raw (HDF5) and `outdir`/summary.json.
-  subroutine empm_verify_run(manifest, outdir, patterns, quick, nfail, err)
+  subroutine empm_verify_run(manifest, outdir, patterns, quick, nfail, err, comm)
     character(len=*), intent(in) :: manifest          !! path of verification/cases.txt
     character(len=*), intent(in) :: outdir            !! output folder (created by the caller)
     character(len=*), intent(in) :: patterns(:)       !! id patterns
     logical, intent(in) :: quick                      !! quick subset
     integer, intent(out) :: nfail                     !! failed checks (cases + convergence)
     type(empm_error_t), intent(out) :: err            !! set on set-up or I/O problems
+    type(empm_comm_t), intent(in), optional :: comm   !! the processes running each case
+                                                      !! together (mpirun; docs/parallel.md):
+                                                      !! the root judges, prints and writes
     type(empm_verify_spec_t), allocatable :: specs(:)
     type(run_t), allocatable :: runs(:)
     real(wp), allocatable :: values(:,:), hval(:)
@@ -77,6 +82,7 @@ contains
     integer :: i, nrun, nsel
     integer(int64) :: c0, c1, rate
     real(wp) :: elapsed
+    logical :: root
 
     nfail = 0
     dir = manifest(1:index(manifest, '/', back=.true.))
@@ -115,6 +121,8 @@ contains
     call js%key('cases'); call js%begin_array()
     call jc%begin_array()
 
+    root = .true.
+    if (present(comm)) root = comm%is_root()
     call system_clock(c0, rate)
     nsel = 0
     do i = 1, nrun
@@ -122,14 +130,20 @@ contains
       nsel = nsel + 1
       call system_clock(c1)
       elapsed = real(c1 - c0, wp) / rate
-      write(output_unit, '(a,i0,a,i0,a,a)', advance='no') '[', nsel, '/', count(done), '] ', &
-        runs(i)%id
-      if (nsel > 1) write(output_unit, '(a,f7.1,a)', advance='no') '  (ETA ', &
-        elapsed / (nsel - 1) * (count(done) - nsel + 1), ' s)'
-      write(output_unit, '(a)') ''
-      flush(output_unit)
+      if (root) then
+        write(output_unit, '(a,i0,a,i0,a,a)', advance='no') '[', nsel, '/', count(done), &
+          '] ', runs(i)%id
+        if (nsel > 1) write(output_unit, '(a,f7.1,a)', advance='no') '  (ETA ', &
+          elapsed / (nsel - 1) * (count(done) - nsel + 1), ' s)'
+        write(output_unit, '(a)') ''
+        flush(output_unit)
+      end if
       call one_run(specs(runs(i)%spec), runs(i), values(:, i), hval(i))
     end do
+    ! The other processes helped run the cases; the root holds the results.
+    if (.not. root) then
+      nfail = 0; return
+    end if
     call js%end_array()
     call convergence_groups()
     call jc%end_array()
@@ -178,6 +192,15 @@ contains
       if (len(msg) > 0) return
       call hist%init(cs%model%grid%ndim, cs%probe_name, cs%probe_particle, 1024, &
                      size(cs%run%snapshot_times))
+      if (present(comm)) then
+        ! The case's particles shared among the processes (after the benchmark set them up).
+        cs%model%comm = comm
+        call empm_partition_particles(cs%model, e)
+        if (e%code /= EMPM_OK) then
+          msg = e%message; return
+        end if
+        call hist%locate_probes(cs%model%pts)
+      end if
       cs%run%progress = .false.
       call empm_solve(cs%model, cs%integ, cs%run, hist, e)
       ran = e%code == EMPM_OK
@@ -185,6 +208,13 @@ contains
       meta%case_file = spec%file; meta%case_text = cs%text
       meta%shape = cs%shape_name; meta%integrator = cs%scheme_name
       meta%cfl = cs%run%cfl; meta%t_end = cs%run%t_end
+      call empm_gather_particles(cs%model, hist, ew)
+      if (.not. root .or. ew%code /= EMPM_OK) then
+        if (ew%code /= EMPM_OK) then
+          ran = .false.; msg = ew%message
+        end if
+        return
+      end if
       call empm_write_results(out, cs%model, hist, meta, ran, msg, ew)
       if (ew%code == EMPM_OK) then
         call bench%write_exact(out, cs, hist, ierr)
@@ -206,7 +236,9 @@ contains
       logical :: passed, ran, expected, ok
       integer :: m, np
       if (spec%study == 'stress_point') then
-        ! A material point driven through an element-test path (no grid, no scheme).
+        ! A material point driven through an element-test path (no grid, no scheme): the
+        ! root's alone.
+        if (.not. root) return
         out = outdir//'/raw/'//flat(r%id)//'.h5'
         call empm_sp_study(spec%file, max(1, spec%levels(r%ilevel)), out, &
                            spec%metrics(1:spec%nmetric), val(1:spec%nmetric), hlevel, msg)
@@ -228,17 +260,20 @@ contains
         ov%cfl = minval(spec%cfls(1:spec%nlevel)) / 8.0_wp
         call execute(spec, ov, outdir//'/raw/'//flat(r%group)//'_reference.h5', cref, href, &
                      bref, ran, msg)
-        if (.not. ran) write(error_unit, '(a)') '  reference run failed: '//msg
-        np = cref%model%pts%np
-        if (trim(spec%metrics(1)) == 'velocity_l2') then
-          ref_u = cref%model%pts%v(:, 1:np)
-        else
-          ref_u = cref%model%pts%x(:, 1:np) - cref%model%pts%x0(:, 1:np)
+        if (root) then
+          if (.not. ran) write(error_unit, '(a)') '  reference run failed: '//msg
+          np = cref%model%pts%np
+          if (trim(spec%metrics(1)) == 'velocity_l2') then
+            ref_u = cref%model%pts%v(:, 1:np)
+          else
+            ref_u = cref%model%pts%x(:, 1:np) - cref%model%pts%x0(:, 1:np)
+          end if
         end if
       end if
       if (spec%study == 'time') ov%cfl = spec%cfls(r%ilevel)
       out = outdir//'/raw/'//flat(r%id)//'.h5'
       call execute(spec, ov, out, cs, hist, bench, ran, msg)
+      if (.not. root) return
       hlevel = cs%model%grid%hmin()
       if (spec%study == 'time') hlevel = spec%cfls(r%ilevel)
       if (spec%study == 'time' .and. ran) then

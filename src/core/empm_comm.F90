@@ -1,0 +1,315 @@
+!> The processes a simulation runs on: a communicator value and the collective operations the
+!> solver needs (sums of nodal fields, global minima and maxima, agreement on a failure,
+!> gathering particle rows on the root). Built with `-DEMPM_USE_MPI=ON` it wraps an `mpi_f08`
+!> communicator (a duplicate of the one it is made from, so empm's messages never meet the
+!> host's); otherwise, and for a communicator of one process, every operation is the identity
+!> and costs nothing. No global state: whoever makes the value owns it (docs/parallel.md).
+module empm_comm
+  use empm_kinds, only: wp
+#ifdef EMPM_USE_MPI
+  use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_COMM_NULL, MPI_Init, MPI_Initialized, &
+    MPI_Finalize, MPI_Finalized, MPI_Comm_rank, MPI_Comm_size, MPI_Comm_dup, MPI_Comm_free, &
+    MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_SUM, &
+    MPI_MAX, MPI_MIN, MPI_LOR, MPI_Bcast, MPI_CHARACTER, MPI_Gather, MPI_Gatherv, MPI_Barrier, &
+    operator(/=)
+#endif
+  implicit none
+  private
+  public :: empm_comm_t, empm_comm_world, empm_comm_serial, EMPM_MPI_BUILT
+
+#ifdef EMPM_USE_MPI
+  logical, parameter :: EMPM_MPI_BUILT = .true.  !! this build can run on several processes
+#else
+  logical, parameter :: EMPM_MPI_BUILT = .false. !! this build can run on several processes
+#endif
+
+  !> A group of processes running one simulation together (one process: serial).
+  type :: empm_comm_t
+    integer :: rank = 0            !! this process, 0 .. nranks − 1
+    integer :: nranks = 1          !! number of processes
+    logical :: owns_mpi = .false.  !! this value started MPI (its `finish` ends it)
+#ifdef EMPM_USE_MPI
+    type(MPI_Comm) :: handle = MPI_COMM_NULL !! private duplicate (null: serial)
+#endif
+  contains
+    procedure :: is_root => comm_is_root
+    procedure :: parallel => comm_parallel
+    procedure, private :: sum_r1, sum_r2, sum_r3
+    generic :: sum => sum_r1, sum_r2, sum_r3
+    procedure :: sum_real => comm_sum_real
+    procedure :: max_real => comm_max_real
+    procedure :: min_real => comm_min_real
+    procedure :: sum_int => comm_sum_int
+    procedure :: max_int => comm_max_int
+    procedure :: min_int => comm_min_int
+    procedure :: bcast_ints => comm_bcast_ints
+    procedure :: any_true => comm_any_true
+    procedure :: bcast_text => comm_bcast_text
+    procedure :: gather_rows => comm_gather_rows
+    procedure :: barrier => comm_barrier
+    procedure :: finish => comm_finish
+  end type empm_comm_t
+
+contains
+
+  !> One process, no MPI: what every library call uses unless given another communicator.
+  pure function empm_comm_serial() result(comm)
+    type(empm_comm_t) :: comm !! rank 0 of 1
+    comm%rank = 0; comm%nranks = 1
+  end function empm_comm_serial
+
+  !> All the processes the program was started on (`mpirun -n N`), starting MPI when nobody has
+  !> yet (then [[empm_comm_t:finish]] ends it). Serial without MPI in the build, and for a
+  !> program not started by a launcher (no launcher variable in the environment: Open MPI's
+  !> OMPI_COMM_WORLD_SIZE, PMIx's PMIX_RANK, PMI's PMI_SIZE): MPI_Init would start a singleton
+  !> runtime, which needs resources (shared memory, files) a plain run must not.
+  function empm_comm_world() result(comm)
+    type(empm_comm_t) :: comm !! the processes of the run
+#ifdef EMPM_USE_MPI
+    logical :: up
+    call MPI_Initialized(up)
+    if (.not. up) then
+      if (.not. launched()) then
+        comm = empm_comm_serial()
+        return
+      end if
+      call MPI_Init()
+      comm%owns_mpi = .true.
+    end if
+    call MPI_Comm_dup(MPI_COMM_WORLD, comm%handle)
+    call MPI_Comm_rank(comm%handle, comm%rank)
+    call MPI_Comm_size(comm%handle, comm%nranks)
+#else
+    comm = empm_comm_serial()
+#endif
+  end function empm_comm_world
+
+#ifdef EMPM_USE_MPI
+  ! A process launcher (mpirun, mpiexec, srun) started this program.
+  logical function launched()
+    character(len=*), parameter :: VARS(3) = [character(len=20) :: 'OMPI_COMM_WORLD_SIZE', &
+                                              'PMIX_RANK', 'PMI_SIZE']
+    integer :: k, n, st
+    launched = .false.
+    do k = 1, size(VARS)
+      call get_environment_variable(trim(VARS(k)), length=n, status=st)
+      if (st == 0 .and. n > 0) launched = .true.
+    end do
+  end function launched
+#endif
+
+  !> .true. on rank 0, which reads alone, writes the files and prints.
+  elemental logical function comm_is_root(self)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    comm_is_root = self%rank == 0
+  end function comm_is_root
+
+  !> .true. when more than one process shares the run.
+  elemental logical function comm_parallel(self)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    comm_parallel = self%nranks > 1
+  end function comm_parallel
+
+  !> a ← Σ over the processes of a (every process gets the sum).
+  subroutine sum_r1(self, a)
+    class(empm_comm_t), intent(in) :: self           !! communicator
+    real(wp), intent(inout), contiguous :: a(:)      !! values, summed in place
+    if (self%nranks <= 1 .or. size(a) == 0) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(MPI_IN_PLACE, a, size(a), MPI_DOUBLE_PRECISION, MPI_SUM, self%handle)
+#endif
+  end subroutine sum_r1
+
+  !> a ← Σ over the processes of a (nodal fields: (ndim, nnode)).
+  subroutine sum_r2(self, a)
+    class(empm_comm_t), intent(in) :: self           !! communicator
+    real(wp), intent(inout), contiguous :: a(:,:)    !! values, summed in place
+    if (self%nranks <= 1 .or. size(a) == 0) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(MPI_IN_PLACE, a, size(a), MPI_DOUBLE_PRECISION, MPI_SUM, self%handle)
+#endif
+  end subroutine sum_r2
+
+  !> a ← Σ over the processes of a.
+  subroutine sum_r3(self, a)
+    class(empm_comm_t), intent(in) :: self           !! communicator
+    real(wp), intent(inout), contiguous :: a(:,:,:)  !! values, summed in place
+    if (self%nranks <= 1 .or. size(a) == 0) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(MPI_IN_PLACE, a, size(a), MPI_DOUBLE_PRECISION, MPI_SUM, self%handle)
+#endif
+  end subroutine sum_r3
+
+  !> Σ over the processes of x.
+  function comm_sum_real(self, x) result(s)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    real(wp), intent(in) :: x              !! this process's value
+    real(wp) :: s                          !! the sum
+    s = x
+    if (self%nranks <= 1) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(x, s, 1, MPI_DOUBLE_PRECISION, MPI_SUM, self%handle)
+#endif
+  end function comm_sum_real
+
+  !> Largest x over the processes.
+  function comm_max_real(self, x) result(s)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    real(wp), intent(in) :: x              !! this process's value
+    real(wp) :: s                          !! the maximum
+    s = x
+    if (self%nranks <= 1) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(x, s, 1, MPI_DOUBLE_PRECISION, MPI_MAX, self%handle)
+#endif
+  end function comm_max_real
+
+  !> Smallest x over the processes.
+  function comm_min_real(self, x) result(s)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    real(wp), intent(in) :: x              !! this process's value
+    real(wp) :: s                          !! the minimum
+    s = x
+    if (self%nranks <= 1) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(x, s, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%handle)
+#endif
+  end function comm_min_real
+
+  !> Σ over the processes of i.
+  function comm_sum_int(self, i) result(s)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    integer, intent(in) :: i               !! this process's value
+    integer :: s                           !! the sum
+    s = i
+    if (self%nranks <= 1) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(i, s, 1, MPI_INTEGER, MPI_SUM, self%handle)
+#endif
+  end function comm_sum_int
+
+  !> Largest i over the processes (agreeing on a status: every process takes the worst).
+  function comm_max_int(self, i) result(s)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    integer, intent(in) :: i               !! this process's value
+    integer :: s                           !! the maximum
+    s = i
+    if (self%nranks <= 1) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(i, s, 1, MPI_INTEGER, MPI_MAX, self%handle)
+#endif
+  end function comm_max_int
+
+  !> Smallest i over the processes.
+  function comm_min_int(self, i) result(s)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    integer, intent(in) :: i               !! this process's value
+    integer :: s                           !! the minimum
+    s = i
+    if (self%nranks <= 1) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(i, s, 1, MPI_INTEGER, MPI_MIN, self%handle)
+#endif
+  end function comm_min_int
+
+  !> Every process gets process `from`'s values of a.
+  subroutine comm_bcast_ints(self, a, from)
+    class(empm_comm_t), intent(in) :: self   !! communicator
+    integer, intent(inout) :: a(:)           !! from's values in, everyone's out
+    integer, intent(in) :: from              !! the process that has them
+    if (self%nranks <= 1 .or. size(a) == 0 .or. from < 0) return
+#ifdef EMPM_USE_MPI
+    call MPI_Bcast(a, size(a), MPI_INTEGER, from, self%handle)
+#endif
+  end subroutine comm_bcast_ints
+
+  !> .true. on every process when it is on any.
+  function comm_any_true(self, l) result(s)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    logical, intent(in) :: l               !! this process's value
+    logical :: s                           !! l on any process
+    s = l
+    if (self%nranks <= 1) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(l, s, 1, MPI_LOGICAL, MPI_LOR, self%handle)
+#endif
+  end function comm_any_true
+
+  !> Every process gets process `from`'s text (a message found on one process only).
+  subroutine comm_bcast_text(self, text, from)
+    class(empm_comm_t), intent(in) :: self                  !! communicator
+    character(len=:), allocatable, intent(inout) :: text    !! from's text in, everyone's out
+    integer, intent(in) :: from                             !! the process that has it
+    integer :: n
+    if (self%nranks <= 1) return
+    n = 0
+    if (self%rank == from) n = len(text)
+#ifdef EMPM_USE_MPI
+    call MPI_Bcast(n, 1, MPI_INTEGER, from, self%handle)
+    if (self%rank /= from) then
+      if (allocated(text)) deallocate(text)
+      allocate(character(len=n) :: text)
+    end if
+    if (n > 0) call MPI_Bcast(text, n, MPI_CHARACTER, from, self%handle)
+#endif
+  end subroutine comm_bcast_text
+
+  !> The root gets every process's rows, process by process: rows(:, 1:n) here, all(:, :) on
+  !> the root (allocated there with the total count of columns; elsewhere size 0).
+  subroutine comm_gather_rows(self, rows, n, all)
+    class(empm_comm_t), intent(in) :: self                  !! communicator
+    real(wp), intent(in), contiguous :: rows(:,:)           !! this process's rows (m, >= n)
+    integer, intent(in) :: n                                !! its number of columns
+    real(wp), allocatable, intent(out) :: all(:,:)          !! the root's (m, Σ n)
+    integer :: m
+#ifdef EMPM_USE_MPI
+    integer, allocatable :: counts(:), displs(:)
+    integer :: k
+#endif
+    m = size(rows, 1)
+    if (self%nranks <= 1) then
+      allocate(all(m, n))
+      all = rows(:, 1:n)
+      return
+    end if
+#ifdef EMPM_USE_MPI
+    allocate(counts(self%nranks), displs(self%nranks))
+    call MPI_Gather(m * n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, 0, self%handle)
+    if (self%rank == 0) then
+      displs(1) = 0
+      do k = 2, self%nranks
+        displs(k) = displs(k - 1) + counts(k - 1)
+      end do
+      allocate(all(m, sum(counts) / max(m, 1)))
+    else
+      allocate(all(m, 0))
+    end if
+    call MPI_Gatherv(rows, m * n, MPI_DOUBLE_PRECISION, all, counts, displs, &
+                     MPI_DOUBLE_PRECISION, 0, self%handle)
+#endif
+  end subroutine comm_gather_rows
+
+  !> Wait for every process.
+  subroutine comm_barrier(self)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    if (self%nranks <= 1) return
+#ifdef EMPM_USE_MPI
+    call MPI_Barrier(self%handle)
+#endif
+  end subroutine comm_barrier
+
+  !> Release the communicator, and end MPI when this value started it (call before exiting).
+  subroutine comm_finish(self)
+    class(empm_comm_t), intent(inout) :: self !! communicator (serial afterwards)
+#ifdef EMPM_USE_MPI
+    logical :: down
+    if (self%handle /= MPI_COMM_NULL) call MPI_Comm_free(self%handle)
+    if (self%owns_mpi) then
+      call MPI_Finalized(down)
+      if (.not. down) call MPI_Finalize()
+    end if
+#endif
+    self%owns_mpi = .false.
+    self%rank = 0; self%nranks = 1
+  end subroutine comm_finish
+end module empm_comm

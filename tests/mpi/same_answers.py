@@ -1,0 +1,208 @@
+#!/usr/bin/python3
+"""Same answers on several processes (docs/parallel.md): every case below is run by `empm run`
+on one process and under `mpirun -n N`, and every floating-point dataset of the two HDF5 files
+is compared. A dataset's difference is max|a - b| over the largest magnitude the quantity takes
+in the file (over all frames: a field near a zero crossing at one snapshot is not compared with
+its own tiny value). One process under mpirun must be bitwise the serial run.
+
+Usage: same_answers.py EMPM MPIRUN WORKDIR [--ranks 2,3,4] [--quick]
+Exit status 0 when every comparison is within the bound, 1 otherwise (one line per failure).
+"""
+import itertools
+import os
+import pathlib
+import subprocess
+import sys
+
+import h5py
+import numpy as np
+
+TOL = 1.0e-12
+
+CASES = {
+    # 1D bar in its first mode: fixed end (with the padding nodes behind it), free end off
+    # the grid line.
+    "bar1d": """&grid
+  ndim = 1, origin = -2.0, h = 1.0, cells = 30
+/
+&material
+  name = 'bar', model = 'linear_elastic', E = 100.0, nu = 0.0, density = 1.0
+/
+&particles
+  material = 'bar', geometry = 'interval', lo = 0.0, hi = 25.3, ppc = 2, placement = 'gauss'
+  velocity_sine_amplitude = 1.0e-2, velocity_sine_wavenumber = 0.0620850
+/
+&shape
+  family = '{shape}' {shape_keys}
+/
+&integrator
+  scheme = '{scheme}', cfl = 0.5, t_end = {t_end}
+/
+&boundary
+  lo = -2.0, hi = 0.0, fix = .true.
+/
+&probe
+  name = 'free_end', point = 25.3
+/
+&output
+  snapshot_times = {snap}
+/
+""",
+    # 2D: two disks that meet and bounce, crossing the processes' boxes.
+    "disks2d": """&grid
+  ndim = 2, origin = -0.1, -0.1, h = 0.05, cells = 24, 24
+/
+&material
+  name = 'disk', model = 'neohookean', E = 1000.0, nu = 0.3, density = 1000.0
+/
+&particles
+  material = 'disk', geometry = 'disk', center = 0.2, 0.2, radius = 0.2, ppc = 2,
+  velocity = 0.1, 0.1
+/
+&particles
+  material = 'disk', geometry = 'disk', center = 0.8, 0.8, radius = 0.2, ppc = 2,
+  velocity = -0.1, -0.1
+/
+&shape
+  family = '{shape}' {shape_keys}
+/
+&integrator
+  scheme = '{scheme}', cfl = 0.3, t_end = {t_end}
+/
+&probe
+  name = 'centre', point = 0.2, 0.2
+/
+&output
+  history_every = 5, snapshot_times = {snap}
+/
+""",
+    # 3D: a block settling under gravity on a fixed base, rollers on the sides.
+    "block3d": """&grid
+  ndim = 3, origin = -0.25, -0.25, -0.25, h = 0.25, cells = 6, 6, 7
+/
+&material
+  name = 'soil', model = 'linear_elastic', E = 1.0e5, nu = 0.25, density = 1000.0
+/
+&particles
+  material = 'soil', geometry = 'box', lo = 0.0, 0.0, 0.0, hi = 1.0, 1.0, 1.0, ppc = 2,
+  placement = 'gauss'
+/
+&shape
+  family = '{shape}' {shape_keys}
+/
+&integrator
+  scheme = '{scheme}', cfl = 0.5, t_end = {t_end}
+/
+&loads
+  gravity = 0.0, 0.0, -9.81
+/
+&boundary
+  lo = -0.25, -0.25, -0.25, hi = 1.25, 1.25, 0.0, fix = .true., .true., .true.
+/
+&output
+  snapshot_times = {snap}
+/
+""",
+}
+
+# Per case: end time and snapshot times (the disks meet at t = 1.6 s and part again).
+TIMES = {"bar1d": (4.0, "1.0, 2.0, 4.0"), "disks2d": (3.0, "1.0, 2.0, 3.0"),
+         "block3d": (0.1, "0.05, 0.1")}
+SCHEMES = ["musl", "usl", "usf", "pc_newmark", "pc_published", "gen_alpha", "gen_alpha_grid"]
+SHAPES = {"linear": "", "ugimp": "", "bspline2": "", "lme": ", gamma = 1.8"}
+
+
+def case_text(name, scheme, shape):
+    t_end, snap = TIMES[name]
+    return CASES[name].format(scheme=scheme, shape=shape, shape_keys=SHAPES[shape],
+                              t_end=t_end, snap=snap)
+
+
+def scales(f):
+    """Largest magnitude of each quantity over the file (by the dataset's last name)."""
+    out = {}
+
+    def visit(name, obj):
+        if isinstance(obj, h5py.Dataset) and obj.dtype.kind == "f" and obj.size:
+            key = name.split("/")[-1]
+            out[key] = max(out.get(key, 0.0), float(np.max(np.abs(obj[...]))))
+    f.visititems(visit)
+    return out
+
+
+def compare(a_path, b_path):
+    """(worst relative difference, its dataset, bitwise equal?)."""
+    worst, where, same = 0.0, "", True
+    with h5py.File(a_path, "r") as a, h5py.File(b_path, "r") as b:
+        sc = scales(a)
+
+        def visit(name, obj):
+            nonlocal worst, where, same
+            if not isinstance(obj, h5py.Dataset) or obj.dtype.kind != "f":
+                return
+            if name not in b:
+                worst, where, same = np.inf, name + " (missing)", False
+                return
+            x, y = obj[...], b[name][...]
+            if x.shape != y.shape:
+                worst, where, same = np.inf, name + f" (shape {x.shape} vs {y.shape})", False
+                return
+            if x.size == 0:
+                return
+            if not np.array_equal(x, y):
+                same = False
+            s = sc.get(name.split("/")[-1], 0.0)
+            d = float(np.max(np.abs(x - y))) / s if s > 0 else float(np.max(np.abs(x - y)))
+            if d > worst:
+                worst, where = d, name
+        a.visititems(visit)
+    return worst, where, same
+
+
+def run(cmd, cwd):
+    r = subprocess.run(cmd, cwd=cwd, capture_output=True, text=True)
+    return r.returncode, r.stdout + r.stderr
+
+
+def main():
+    empm, mpirun, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
+    ranks = [2, 3, 4]
+    quick = "--quick" in sys.argv
+    if "--ranks" in sys.argv:
+        ranks = [int(k) for k in sys.argv[sys.argv.index("--ranks") + 1].split(",")]
+    work.mkdir(parents=True, exist_ok=True)
+    mpi = [mpirun, "--oversubscribe"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
+    env_note = []
+    combos = list(itertools.product(CASES, SCHEMES, SHAPES))
+    if quick:
+        combos = [c for c in combos if c[2] == "linear" or c[1] == "pc_newmark"]
+    failures = 0
+    for name, scheme, shape in combos:
+        tag = f"{name}_{scheme}_{shape}"
+        nml = work / f"{tag}.nml"
+        nml.write_text(case_text(name, scheme, shape))
+        rc, log = run([empm, "run", str(nml), "-o", f"{tag}_s.h5"], work)
+        if rc != 0:
+            print(f"FAIL {tag}: serial run exited {rc}: {log.strip()[-300:]}")
+            failures += 1
+            continue
+        for n in [1] + ranks:
+            out = f"{tag}_p{n}.h5"
+            rc, log = run(mpi + ["-n", str(n), empm, "run", str(nml), "-o", out], work)
+            if rc != 0:
+                print(f"FAIL {tag} -n {n}: exited {rc}: {log.strip()[-300:]}")
+                failures += 1
+                continue
+            worst, where, same = compare(work / f"{tag}_s.h5", work / out)
+            ok = same if n == 1 else worst <= TOL
+            print(f"{'ok  ' if ok else 'FAIL'} {tag:32s} -n {n}: "
+                  f"{'bitwise' if same else f'{worst:.2e} ({where})'}")
+            failures += 0 if ok else 1
+            (work / out).unlink(missing_ok=True)
+            (work / out.replace(".h5", ".xmf")).unlink(missing_ok=True)
+    print(f"{len(combos)} cases, {failures} failures{'; ' + ' '.join(env_note) if env_note else ''}")
+    return 1 if failures else 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
