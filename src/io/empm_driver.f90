@@ -51,6 +51,25 @@ contains
     sig = empm_stop_signal()
   end function hook_stop
 
+  ! Every process of `comm` takes the error of the first process that has one (or none).
+  subroutine agree_first_error(comm, e)
+    type(empm_comm_t), intent(in) :: comm
+    type(empm_error_t), intent(inout) :: e
+    integer :: first, v(1)
+    character(len=:), allocatable :: text
+    if (.not. comm%parallel()) return
+    first = comm%min_int(merge(comm%rank, comm%nranks, e%code /= EMPM_OK))
+    if (first == comm%nranks) return
+    v(1) = e%code
+    call comm%bcast_ints(v, first)
+    text = ''
+    if (comm%rank == first) text = e%message
+    call comm%bcast_text(text, first)
+    if (comm%rank /= first) then
+      e%code = v(1); e%message = text
+    end if
+  end subroutine agree_first_error
+
   !> Run the case in `path`, writing HDF5 to `output` (default: the case's &output file).
   !> Exit-status semantics when `err` is absent: 2 invalid input, 3 run-time guard, 4 I/O.
   !> A run stopped by a guard still writes its last good state, marked incomplete.
@@ -106,6 +125,9 @@ contains
 
     call empm_cpu_sample(load0)
     call empm_read_case(path, cs, e, extra_groups=extra_groups)
+    ! Each process reads the case: one that cannot (a file missing on its machine) must not
+    ! leave the others waiting. All take the error of the first process that has one.
+    if (present(comm)) call agree_first_error(comm, e)
     if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
     end if
@@ -133,7 +155,7 @@ contains
     end if
     ! The root claims the output for all (one file, one lock); its verdict is everyone's.
     if (cs%model%comm%is_root()) call empm_output_claim(cs%output_file, e)
-    call agree_error(e)
+    call agree_first_error(cs%model%comm, e)
     if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
     end if
@@ -179,7 +201,7 @@ contains
         call empm_write_results(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
       end if
     end if
-    call agree_error(ew)
+    call agree_first_error(cs%model%comm, ew)
     call release()
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then
@@ -203,22 +225,6 @@ contains
     end if
 
   contains
-
-    ! The root's error (output claim, writing) on every process.
-    subroutine agree_error(ec)
-      type(empm_error_t), intent(inout) :: ec
-      integer :: v(1)
-      character(len=:), allocatable :: text
-      if (.not. cs%model%comm%parallel()) return
-      v(1) = ec%code
-      call cs%model%comm%bcast_ints(v, 0)
-      text = ''
-      if (cs%model%comm%is_root() .and. allocated(ec%message)) text = ec%message
-      call cs%model%comm%bcast_text(text, 0)
-      if (.not. cs%model%comm%is_root()) then
-        ec%code = v(1); ec%message = text
-      end if
-    end subroutine agree_error
 
     ! The root releases the output it claimed.
     subroutine release()

@@ -5,13 +5,16 @@
    the results written (marked incomplete) equal the serial run's last good state;
 2. a stress update that fails on one process (a particle inverted) does the same;
 3. a case file error is reported once, with exit status 2 on every process;
-4. checkpoints, not yet available on several processes, are refused with exit status 2.
+4. checkpoints, not yet available on several processes, are refused with exit status 2;
+5. a file the case needs that is missing on one process only (its own working folder, with
+   mpirun's MPMD form) gives status 2 and one message naming the file, on every process.
 No process may hang: each run has a time limit.
 
 Usage: stops.py EMPM MPIRUN WORKDIR [--ranks 2,3]
 """
 import os
 import pathlib
+import shutil
 import subprocess
 import sys
 
@@ -125,6 +128,21 @@ def main():
                         if not d <= 1e-12:
                             fails.append(f"{name} -n {n}: {ds} differs by {d:.2e}")
             print(f"ok   {name} -n {n}: exit {rc}: {errs[0][:110]}")
+    # 5. The mesh of examples/embankment_2d.nml next to the case for process 0 only.
+    examples = pathlib.Path(__file__).resolve().parents[2] / "examples"
+    for sub in ("A", "B"):
+        (work / sub).mkdir(exist_ok=True)
+        shutil.copy(examples / "embankment_2d.nml", work / sub)
+    shutil.copy(examples / "embankment_2d.msh", work / "A")
+    (work / "B" / "embankment_2d.msh").unlink(missing_ok=True)
+    rc, log = run(mpi + ["-n", "1", "--wdir", str(work / "A"), empm, "run", "embankment_2d.nml",
+                         ":", "-n", "1", "--wdir", str(work / "B"), empm, "run",
+                         "embankment_2d.nml"], work)
+    errs = error_lines(log)
+    if rc != 2 or len(errs) != 1 or "embankment_2d.msh" not in errs[0]:
+        fails.append(f"missing file on process 1: exit {rc}, messages {errs}: {log[-400:]}")
+    else:
+        print(f"ok   missing file on process 1 of 2: exit {rc}: {errs[0][:110]}")
     for f in fails:
         print("FAIL", f)
     return 1 if fails else 0
