@@ -42,7 +42,20 @@ contains
     type(empm_history_t), intent(in) :: hist
     type(empm_solver_state_t), intent(in) :: state
     type(empm_error_t), intent(out) :: err
-    call empm_checkpoint_write(self%path, self%prev, model, hist, state, self%case_text, err)
+    type(empm_model_t) :: whole
+    type(empm_history_t) :: hwhole
+    if (.not. model%comm%parallel()) then
+      call empm_checkpoint_write(self%path, self%prev, model, hist, state, self%case_text, err)
+      return
+    end if
+    ! Several processes: the root writes one checkpoint with every particle in id order (as
+    ! a serial run's), from copies, so that the run goes on with its own share; any number of
+    ! processes can restart from it.
+    whole = model; hwhole = hist
+    call empm_gather_particles(whole, hwhole, err)
+    if (err%code == EMPM_OK .and. model%comm%is_root()) &
+      call empm_checkpoint_write(self%path, self%prev, whole, hwhole, state, self%case_text, err)
+    call agree_first_error(model%comm, err)
   end subroutine hook_checkpoint
 
   integer function hook_stop(self) result(sig)
@@ -144,10 +157,11 @@ contains
       if (present(auto_threads)) then
         if (auto_threads) call empm_set_threads(1)
       end if
-      if (resumed .or. cs%run%checkpoint_every > 0 .or. cs%run%checkpoint_seconds > 0.0_wp) then
+      if ((resumed .or. cs%run%checkpoint_every > 0 .or. cs%run%checkpoint_seconds > 0.0_wp) &
+          .and. cs%model%loads%ntraction() > 0) then
         call e%set(EMPM_ERR_INPUT, path//': checkpoints (&output checkpoint_every, '// &
-          'checkpoint_seconds) and --restart are not available on several processes yet '// &
-          '(docs/parallel.md); run on one process for them')
+          'checkpoint_seconds, --restart) of a case with surface tractions (&traction) are '// &
+          'not available on several processes yet (docs/parallel.md); run on one process')
         call empm_raise_error(e, err); return
       end if
     else if (present(auto_threads)) then
@@ -170,20 +184,26 @@ contains
     hook%path = empm_checkpoint_path(cs%output_file)
     hook%prev = empm_checkpoint_path(cs%output_file, prev=.true.)
     hook%case_text = cs%text
+    if (resumed) then
+      ! Every process reads the whole checkpoint (written by any number of processes: it
+      ! holds every particle in id order), then takes its share below.
+      call empm_checkpoint_read(trim(restart), cs%model, hist, sst, cs%text, warning, e)
+      call agree_first_error(cs%model%comm, e)
+      if (e%code /= EMPM_OK) then
+        call release()
+        call empm_raise_error(e, err); return
+      end if
+      if (len(warning) > 0 .and. cs%run%progress .and. cs%model%comm%is_root()) &
+        write(error_unit, '(a)') 'empm: note: '//warning
+    end if
     if (cs%model%comm%parallel()) then
-      call empm_partition_particles(cs%model, e)
+      call empm_partition_particles(cs%model, e, hist)
       if (e%code /= EMPM_OK) then
         call release(); call empm_raise_error(e, err); return
       end if
       call hist%locate_probes(cs%model%pts)
     end if
     if (resumed) then
-      call empm_checkpoint_read(trim(restart), cs%model, hist, sst, cs%text, warning, e)
-      if (e%code /= EMPM_OK) then
-        call release()
-        call empm_raise_error(e, err); return
-      end if
-      if (len(warning) > 0 .and. cs%run%progress) write(error_unit, '(a)') 'empm: note: '//warning
       call empm_solve(cs%model, cs%integ, cs%run, hist, e, stats, hook=hook, resume=sst)
     else
       call empm_solve(cs%model, cs%integ, cs%run, hist, e, stats, hook=hook)
@@ -206,11 +226,7 @@ contains
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then
       ! The guard's error, with its location fields; the message says where the state went.
-      if (e%code == EMPM_ERR_INTERRUPTED .and. ew%code == EMPM_OK .and. &
-          cs%model%comm%parallel()) then
-        e%message = e%message//'; results so far written to '//cs%output_file// &
-          ', marked incomplete'
-      else if (e%code == EMPM_ERR_INTERRUPTED .and. ew%code == EMPM_OK) then
+      if (e%code == EMPM_ERR_INTERRUPTED .and. ew%code == EMPM_OK) then
         e%message = e%message//' to '//hook%path//'; results so far written to '// &
           cs%output_file//', marked incomplete; continue with --restart '//hook%path
       else if (ew%code == EMPM_OK) then

@@ -17,9 +17,12 @@ contains
   !> set before: the case read, or a checkpoint read, on each). The particles keep their ids,
   !> which order them in the output; nodal masses and the empty-node threshold are those of
   !> the whole set. Serial: nothing changes.
-  subroutine empm_partition_particles(model, err)
+  subroutine empm_partition_particles(model, err, hist)
     type(empm_model_t), intent(inout) :: model          !! model (set up)
     type(empm_error_t), intent(inout), optional :: err  !! allocation failure, if present
+    type(empm_history_t), intent(inout), optional :: hist !! a record with snapshots of every
+                                                        !! particle (a checkpoint's): they keep
+                                                        !! this process's particles too
     type(empm_error_t) :: e
     integer, allocatable :: counts(:), mine(:), owner(:)
     integer :: lo(3, model%comm%nranks), hi(3, model%comm%nranks), ijk(3), nc(3)
@@ -52,12 +55,27 @@ contains
     mass_tol = model%nodes%mass_tol
     call keep_tractions(model, owner)
     call model%pts%keep(mine)
+    if (present(hist)) then
+      do p = 1, hist%nsnap
+        call keep_snapshot(hist%snap(p), mine)
+      end do
+    end if
     call model%set_runs(e)
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
     model%nodes%mass_tol = mass_tol
   end subroutine empm_partition_particles
+  ! A snapshot of every particle keeps the columns `mine`.
+  subroutine keep_snapshot(sn, mine)
+    type(empm_snapshot_t), intent(inout) :: sn
+    integer, intent(in) :: mine(:)
+    sn%x = sn%x(:, mine); sn%v = sn%v(:, mine)
+    sn%stress = sn%stress(:, mine); sn%strain = sn%strain(:, mine)
+    sn%m = sn%m(mine); sn%vol = sn%vol(mine); sn%rho = sn%rho(mine)
+    sn%state = sn%state(:, mine)
+  end subroutine keep_snapshot
+
   ! Each traction keeps the loaded particles this process holds, renumbered as they will be.
   subroutine keep_tractions(model, owner)
     type(empm_model_t), intent(inout) :: model

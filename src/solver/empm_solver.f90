@@ -365,10 +365,9 @@ contains
       call skip_past_snapshots()
       if (show) call progress()
       if (present(hook)) then
+        ! Every process stops, and checkpoints, at the same step.
         sig = model%comm%max_int(hook%stop_requested())
-        ! No checkpoints on several processes yet (docs/parallel.md): the driver refuses
-        ! their keys, and a stop request ends the run with its results only.
-        if (.not. model%comm%parallel() .and. (checkpoint_due() .or. sig /= 0)) then
+        if (model%comm%any_true(checkpoint_due()) .or. sig /= 0) then
           call checkpoint(e)
           if (e%code /= 0) then
             if (show .and. tty) write(error_unit, '(a)') ''
@@ -378,15 +377,9 @@ contains
         if (sig /= 0) then
           if (show .and. tty) write(error_unit, '(a)') ''
           call finish_stats()
-          if (model%comm%parallel()) then
-            call empm_raise(EMPM_ERR_INTERRUPTED, 'stopped by '//signal_name(sig)// &
-              ' after step '//str(model%step)//' at t = '//str(model%t)// &
-              ' s (no checkpoint: not available on several processes yet)', err)
-          else
-            call empm_raise(EMPM_ERR_INTERRUPTED, 'stopped by '//signal_name(sig)// &
-              ' after step '//str(model%step)//' at t = '//str(model%t)// &
-              ' s: checkpoint written', err)
-          end if
+          call empm_raise(EMPM_ERR_INTERRUPTED, 'stopped by '//signal_name(sig)// &
+            ' after step '//str(model%step)//' at t = '//str(model%t)// &
+            ' s: checkpoint written', err)
           return
         end if
       end if

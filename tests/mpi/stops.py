@@ -5,7 +5,8 @@
    the results written (marked incomplete) equal the serial run's last good state;
 2. a stress update that fails on one process (a particle inverted) does the same;
 3. a case file error is reported once, with exit status 2 on every process;
-4. checkpoints, not yet available on several processes, are refused with exit status 2;
+4. checkpoints of a case with surface tractions, not yet available on several processes, are
+   refused with exit status 2;
 5. a file the case needs that is missing on one process only (its own working folder, with
    mpirun's MPMD form) gives status 2 and one message naming the file, on every process.
 No process may hang: each run has a time limit.
@@ -64,7 +65,14 @@ INVERT = """&grid
 """
 
 BAD = LEAVE.replace("cfl = 0.5", "cfl = -0.5")
-CKPT = LEAVE.replace("snapshot_times = 0.05", "snapshot_times = 0.05, checkpoint_every = 10")
+# Checkpoints of a case with surface tractions (their per-particle state is not gathered yet).
+CKPT = LEAVE.replace("snapshot_times = 0.05", "snapshot_times = 0.05, checkpoint_every = 10") \
+    .replace("material = 'm', geometry = 'box', lo = 0.2, 0.2, hi = 0.8, 0.8, ppc = 2",
+             "name = 'left', material = 'm', geometry = 'box', lo = 0.2, 0.2, hi = 0.8, 0.8, "
+             "ppc = 2") + """&traction
+  name = 'top', body = 'left', lo = 0.2, 0.76, hi = 0.8, 0.8, face = '+y', pressure = 10.0
+/
+"""
 
 
 def run(cmd, cwd):
@@ -107,7 +115,7 @@ def main():
                 fails.append(f"{name} -n {n}: {len(errs)} error lines, expected one: {errs}")
                 continue
             if name == "ckpt":
-                if "not available on several processes" not in errs[0]:
+                if "surface tractions" not in errs[0]:
                     fails.append(f"{name} -n {n}: unexpected message {errs[0]}")
                 print(f"ok   {name} -n {n}: exit {rc}: {errs[0][:110]}")
                 continue
