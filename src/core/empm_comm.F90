@@ -10,7 +10,7 @@ module empm_comm
   use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_COMM_NULL, MPI_Init, MPI_Initialized, &
     MPI_Finalize, MPI_Finalized, MPI_Comm_rank, MPI_Comm_size, MPI_Comm_dup, MPI_Comm_free, &
     MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_SUM, &
-    MPI_MAX, MPI_MIN, MPI_LOR, MPI_Bcast, MPI_CHARACTER, MPI_Gather, MPI_Gatherv, MPI_Barrier, &
+    MPI_Op, MPI_MAX, MPI_MIN, MPI_LOR, MPI_Bcast, MPI_CHARACTER, MPI_Gather, MPI_Gatherv, MPI_Barrier, &
     operator(/=)
 #endif
   implicit none
@@ -22,6 +22,7 @@ module empm_comm
 #else
   logical, parameter :: EMPM_MPI_BUILT = .false. !! this build can run on several processes
 #endif
+  integer, parameter :: OP_SUM = 1, OP_MAX = 2, OP_MIN = 3 ! reductions
 
   !> A group of processes running one simulation together (one process: serial).
   type :: empm_comm_t
@@ -114,42 +115,40 @@ contains
   subroutine sum_r1(self, a)
     class(empm_comm_t), intent(in) :: self           !! communicator
     real(wp), intent(inout), contiguous :: a(:)      !! values, summed in place
-    if (self%nranks <= 1 .or. size(a) == 0) return
-#ifdef EMPM_USE_MPI
-    call MPI_Allreduce(MPI_IN_PLACE, a, size(a), MPI_DOUBLE_PRECISION, MPI_SUM, self%handle)
-#endif
+    call sum_buffer(self, a, size(a))
   end subroutine sum_r1
 
   !> a ← Σ over the processes of a (nodal fields: (ndim, nnode)).
   subroutine sum_r2(self, a)
     class(empm_comm_t), intent(in) :: self           !! communicator
     real(wp), intent(inout), contiguous :: a(:,:)    !! values, summed in place
-    if (self%nranks <= 1 .or. size(a) == 0) return
-#ifdef EMPM_USE_MPI
-    call MPI_Allreduce(MPI_IN_PLACE, a, size(a), MPI_DOUBLE_PRECISION, MPI_SUM, self%handle)
-#endif
+    call sum_buffer(self, a, size(a))
   end subroutine sum_r2
 
   !> a ← Σ over the processes of a.
   subroutine sum_r3(self, a)
     class(empm_comm_t), intent(in) :: self           !! communicator
     real(wp), intent(inout), contiguous :: a(:,:,:)  !! values, summed in place
+    call sum_buffer(self, a, size(a))
+  end subroutine sum_r3
+
+  ! The n values of a contiguous array of any rank (sequence association), summed in place.
+  subroutine sum_buffer(self, a, n)
+    class(empm_comm_t), intent(in) :: self
+    integer, intent(in) :: n
+    real(wp), intent(inout) :: a(n)
     if (self%nranks <= 1 .or. size(a) == 0) return
 #ifdef EMPM_USE_MPI
-    call MPI_Allreduce(MPI_IN_PLACE, a, size(a), MPI_DOUBLE_PRECISION, MPI_SUM, self%handle)
+    call MPI_Allreduce(MPI_IN_PLACE, a, n, MPI_DOUBLE_PRECISION, MPI_SUM, self%handle)
 #endif
-  end subroutine sum_r3
+  end subroutine sum_buffer
 
   !> Σ over the processes of x.
   function comm_sum_real(self, x) result(s)
     class(empm_comm_t), intent(in) :: self !! communicator
     real(wp), intent(in) :: x              !! this process's value
     real(wp) :: s                          !! the sum
-    s = x
-    if (self%nranks <= 1) return
-#ifdef EMPM_USE_MPI
-    call MPI_Allreduce(x, s, 1, MPI_DOUBLE_PRECISION, MPI_SUM, self%handle)
-#endif
+    s = reduce_real(self, x, OP_SUM)
   end function comm_sum_real
 
   !> Largest x over the processes.
@@ -157,11 +156,7 @@ contains
     class(empm_comm_t), intent(in) :: self !! communicator
     real(wp), intent(in) :: x              !! this process's value
     real(wp) :: s                          !! the maximum
-    s = x
-    if (self%nranks <= 1) return
-#ifdef EMPM_USE_MPI
-    call MPI_Allreduce(x, s, 1, MPI_DOUBLE_PRECISION, MPI_MAX, self%handle)
-#endif
+    s = reduce_real(self, x, OP_MAX)
   end function comm_max_real
 
   !> Smallest x over the processes.
@@ -169,11 +164,7 @@ contains
     class(empm_comm_t), intent(in) :: self !! communicator
     real(wp), intent(in) :: x              !! this process's value
     real(wp) :: s                          !! the minimum
-    s = x
-    if (self%nranks <= 1) return
-#ifdef EMPM_USE_MPI
-    call MPI_Allreduce(x, s, 1, MPI_DOUBLE_PRECISION, MPI_MIN, self%handle)
-#endif
+    s = reduce_real(self, x, OP_MIN)
   end function comm_min_real
 
   !> Σ over the processes of i.
@@ -181,11 +172,7 @@ contains
     class(empm_comm_t), intent(in) :: self !! communicator
     integer, intent(in) :: i               !! this process's value
     integer :: s                           !! the sum
-    s = i
-    if (self%nranks <= 1) return
-#ifdef EMPM_USE_MPI
-    call MPI_Allreduce(i, s, 1, MPI_INTEGER, MPI_SUM, self%handle)
-#endif
+    s = reduce_int(self, i, OP_SUM)
   end function comm_sum_int
 
   !> Largest i over the processes (agreeing on a status: every process takes the worst).
@@ -193,11 +180,7 @@ contains
     class(empm_comm_t), intent(in) :: self !! communicator
     integer, intent(in) :: i               !! this process's value
     integer :: s                           !! the maximum
-    s = i
-    if (self%nranks <= 1) return
-#ifdef EMPM_USE_MPI
-    call MPI_Allreduce(i, s, 1, MPI_INTEGER, MPI_MAX, self%handle)
-#endif
+    s = reduce_int(self, i, OP_MAX)
   end function comm_max_int
 
   !> Smallest i over the processes.
@@ -205,12 +188,47 @@ contains
     class(empm_comm_t), intent(in) :: self !! communicator
     integer, intent(in) :: i               !! this process's value
     integer :: s                           !! the minimum
-    s = i
-    if (self%nranks <= 1) return
-#ifdef EMPM_USE_MPI
-    call MPI_Allreduce(i, s, 1, MPI_INTEGER, MPI_MIN, self%handle)
-#endif
+    s = reduce_int(self, i, OP_MIN)
   end function comm_min_int
+
+  ! x reduced over the processes by OP_SUM, OP_MAX or OP_MIN.
+  function reduce_real(self, x, op) result(s)
+    class(empm_comm_t), intent(in) :: self
+    real(wp), intent(in) :: x
+    integer, intent(in) :: op
+    real(wp) :: s
+    s = x
+    if (self%nranks <= 1 .or. op < 0) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(x, s, 1, MPI_DOUBLE_PRECISION, mpi_op(op), self%handle)
+#endif
+  end function reduce_real
+
+  ! i reduced over the processes by OP_SUM, OP_MAX or OP_MIN.
+  function reduce_int(self, i, op) result(s)
+    class(empm_comm_t), intent(in) :: self
+    integer, intent(in) :: i
+    integer, intent(in) :: op
+    integer :: s
+    s = i
+    if (self%nranks <= 1 .or. op < 0) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(i, s, 1, MPI_INTEGER, mpi_op(op), self%handle)
+#endif
+  end function reduce_int
+
+#ifdef EMPM_USE_MPI
+  ! The MPI operation of OP_SUM, OP_MAX, OP_MIN.
+  function mpi_op(op) result(o)
+    integer, intent(in) :: op
+    type(MPI_Op) :: o
+    select case (op)
+    case (OP_MAX); o = MPI_MAX
+    case (OP_MIN); o = MPI_MIN
+    case default; o = MPI_SUM
+    end select
+  end function mpi_op
+#endif
 
   !> Every process gets process `from`'s values of a.
   subroutine comm_bcast_ints(self, a, from)
