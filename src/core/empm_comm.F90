@@ -200,7 +200,7 @@ contains
     s = x
     if (self%nranks <= 1 .or. op < 0) return
 #ifdef EMPM_USE_MPI
-    call MPI_Allreduce(x, s, 1, MPI_DOUBLE_PRECISION, mpi_op(op), self%handle)
+    call MPI_Allreduce(x, s, 1, MPI_DOUBLE_PRECISION, op_of(op), self%handle)
 #endif
   end function reduce_real
 
@@ -213,13 +213,13 @@ contains
     s = i
     if (self%nranks <= 1 .or. op < 0) return
 #ifdef EMPM_USE_MPI
-    call MPI_Allreduce(i, s, 1, MPI_INTEGER, mpi_op(op), self%handle)
+    call MPI_Allreduce(i, s, 1, MPI_INTEGER, op_of(op), self%handle)
 #endif
   end function reduce_int
 
 #ifdef EMPM_USE_MPI
   ! The MPI operation of OP_SUM, OP_MAX, OP_MIN.
-  function mpi_op(op) result(o)
+  function op_of(op) result(o)
     integer, intent(in) :: op
     type(MPI_Op) :: o
     select case (op)
@@ -227,7 +227,7 @@ contains
     case (OP_MIN); o = MPI_MIN
     case default; o = MPI_SUM
     end select
-  end function mpi_op
+  end function op_of
 #endif
 
   !> Every process gets process `from`'s values of a.
