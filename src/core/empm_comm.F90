@@ -10,7 +10,8 @@ module empm_comm
   use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_COMM_NULL, MPI_Init, MPI_Initialized, &
     MPI_Finalize, MPI_Finalized, MPI_Comm_rank, MPI_Comm_size, MPI_Comm_dup, MPI_Comm_free, &
     MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_SUM, &
-    MPI_Op, MPI_MAX, MPI_MIN, MPI_LOR, MPI_Bcast, MPI_CHARACTER, MPI_Gather, MPI_Gatherv, MPI_Barrier, &
+    MPI_Op, MPI_MAX, MPI_MIN, MPI_LOR, MPI_Bcast, MPI_Alltoall, MPI_Alltoallv, MPI_CHARACTER, &
+    MPI_Gather, MPI_Gatherv, MPI_Barrier, &
     operator(/=)
 #endif
   implicit none
@@ -47,6 +48,7 @@ module empm_comm
     procedure :: any_true => comm_any_true
     procedure :: bcast_text => comm_bcast_text
     procedure :: gather_rows => comm_gather_rows
+    procedure :: exchange_rows => comm_exchange_rows
     procedure :: barrier => comm_barrier
     procedure :: finish => comm_finish
   end type empm_comm_t
@@ -306,6 +308,56 @@ contains
                      MPI_DOUBLE_PRECISION, 0, self%handle)
 #endif
   end subroutine comm_gather_rows
+
+  !> Every process sends each of its rows to the process `dest` names (itself included) and
+  !> gets the rows sent to it, process by process in rank order, each process's in its order.
+  subroutine comm_exchange_rows(self, rows, n, dest, got)
+    class(empm_comm_t), intent(in) :: self                  !! communicator
+    real(wp), intent(in), contiguous :: rows(:,:)           !! this process's rows (m, >= n)
+    integer, intent(in) :: n                                !! its number of rows
+    integer, intent(in) :: dest(:)                          !! the process of each (n), 0-based
+    real(wp), allocatable, intent(out) :: got(:,:)          !! the rows received (m, k)
+    real(wp), allocatable :: sorted(:,:)
+    integer, allocatable :: scount(:), sdisp(:), rcount(:), rdisp(:), next(:)
+    integer :: m, k, q
+    m = size(rows, 1)
+    if (self%nranks <= 1) then
+      allocate(got(m, n))
+      got = rows(:, 1:n)
+      return
+    end if
+    allocate(scount(self%nranks), sdisp(self%nranks), rcount(self%nranks), &
+             rdisp(self%nranks), next(self%nranks))
+    scount = 0
+    do k = 1, n
+      scount(dest(k) + 1) = scount(dest(k) + 1) + 1
+    end do
+    sdisp(1) = 0
+    do q = 2, self%nranks
+      sdisp(q) = sdisp(q - 1) + scount(q - 1)
+    end do
+    ! Rows grouped by destination, each group in this process's order.
+    allocate(sorted(m, n))
+    next = sdisp
+    do k = 1, n
+      q = dest(k) + 1
+      next(q) = next(q) + 1
+      sorted(:, next(q)) = rows(:, k)
+    end do
+    rcount = scount
+#ifdef EMPM_USE_MPI
+    call MPI_Alltoall(scount, 1, MPI_INTEGER, rcount, 1, MPI_INTEGER, self%handle)
+#endif
+    rdisp(1) = 0
+    do q = 2, self%nranks
+      rdisp(q) = rdisp(q - 1) + rcount(q - 1)
+    end do
+    allocate(got(m, sum(rcount)))
+#ifdef EMPM_USE_MPI
+    call MPI_Alltoallv(sorted, m * scount, m * sdisp, MPI_DOUBLE_PRECISION, got, m * rcount, &
+                       m * rdisp, MPI_DOUBLE_PRECISION, self%handle)
+#endif
+  end subroutine comm_exchange_rows
 
   !> Wait for every process.
   subroutine comm_barrier(self)

@@ -274,14 +274,25 @@ contains
   !> images; with the extension of nearly-empty nodes on ([[empm_extension]]), find them (their
   !> filled volumes in one more P2G) and gather the masses, m̂ = Eᵀm. Without mirrors and
   !> degenerate nodes nothing changes. (A carried basis keeps its masses: [[map_velocity]].)
-  subroutine extend_masses(self, model)
+  subroutine extend_masses(self, model, again)
     class(empm_integrator_t), intent(inout) :: self   !! integrator (P2G workspace)
     type(empm_model_t), intent(inout) :: model        !! simulation state
+    logical, intent(in), optional :: again            !! the basis repeats the last evaluation
+                                                      !! (a carried basis made again): its
+                                                      !! fill is that of the volumes it used
+    logical :: repeat
+    integer :: np
+    repeat = .false.
+    if (present(again)) repeat = again
     associate (nodes => model%nodes)
       if (nodes%nmirror > 0) call nodes%mirror_gather_mass()
       if (nodes%ext%theta <= 0.0_wp) return
+      ! The fill of a carried basis comes from the volumes before the step's stress update;
+      ! a restart or a re-cut that evaluates it again must see the same ones.
+      np = model%pts%np
+      if (.not. repeat) model%pts%vol_fill(1:np) = model%pts%vol(1:np)
       nodes%vol = 0.0_wp
-      call p2g_mass(model%basis, model%pts%vol, nodes%vol, self%p2g)
+      call p2g_mass(model%basis, model%pts%vol_fill, nodes%vol, self%p2g)
       call model%comm%sum(nodes%vol)
       call nodes%find_degenerate(model%grid)
       if (nodes%ext%n > 0) call nodes%ext%gather_mass(nodes%mass)
@@ -328,6 +339,7 @@ contains
     type(empm_step_status_t), intent(inout) :: stat   !! set on failure
     real(wp), intent(in), optional :: c               !! scale of `w`
     real(wp), intent(in), contiguous, optional :: w(:,:) !! second particle vectors (ndim, np)
+    logical :: again
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
       call tm%mark()
       if (self%basis_ready) then
@@ -342,7 +354,8 @@ contains
         end if
         call model%comm%sum(nodes%mom)
       else
-        call eval_basis(model, stat, tm, self%p2g, self%reeval)
+        again = self%reeval
+        call eval_basis(model, stat, tm, self%p2g, again)
         self%reeval = .false.
         call tm%lap(PHASE_SHAPE)
         if (stat%code /= 0) return
@@ -355,7 +368,7 @@ contains
         end if
         call model%comm%sum(nodes%mass)
         call model%comm%sum(nodes%mom)
-        call extend_masses(self, model)
+        call extend_masses(self, model, again)
       end if
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)

@@ -105,6 +105,7 @@ contains
       call h5_write(g, 'lam_old', p%lam_old(:, 1:n), ierr)
       call h5_write(g, 'lam_prev', p%lam_prev(:, 1:n), ierr)
       call h5_write(g, 'lam_old_prev', p%lam_old_prev(:, 1:n), ierr)
+      call h5_write(g, 'vol_fill', p%vol_fill(1:n), ierr)
       call h5_write(g, 'mat', real(p%mat(1:n), wp), ierr)
       if (p%nstate > 0) call h5_write(g, 'state', p%state(:, 1:n), ierr)
     end associate
@@ -287,6 +288,12 @@ contains
       call h5_read(g, 'lam_old', p%lam_old(:, 1:n), ierr)
       call h5_read(g, 'lam_prev', p%lam_prev(:, 1:n), ierr)
       call h5_read(g, 'lam_old_prev', p%lam_old_prev(:, 1:n), ierr)
+      ! Checkpoints before session 12 lack it: the current volumes (what they restarted with).
+      if (h5_exists(g, 'vol_fill')) then
+        call h5_read(g, 'vol_fill', p%vol_fill(1:n), ierr)
+      else
+        p%vol_fill(1:n) = p%vol(1:n)
+      end if
       deallocate(r1); allocate(r1(n)); call h5_read(g, 'mat', r1, ierr)
       p%mat(1:n) = nint(r1)
       if (p%nstate > 0) call h5_read(g, 'state', p%state(:, 1:n), ierr)
@@ -367,7 +374,7 @@ contains
 
     ! The histories as recorded up to the checkpoint, in arrays with room to grow.
     subroutine restore_history()
-      integer :: c, np_, d, ks
+      integer :: c, np_, d, ks, kid
       real(wp) :: ssc(2)
       d = size(hist%px, 1); np_ = hist%nprobe
       c = max(size(hist%t), nt, 16)
@@ -428,6 +435,7 @@ contains
           call read1(gk, 'm', np, sn%m); call read1(gk, 'vol', np, sn%vol)
           call read1(gk, 'rho', np, sn%rho)
           call read2(gk, 'state', ns, np, sn%state)
+          sn%id = [(kid, kid = 1, np)] ! a checkpoint holds every particle in id order
         end associate
         call h5_close_group(gk, ierr)
       end do

@@ -22,6 +22,7 @@ module empm_history
     real(wp), allocatable :: m(:)        !! masses (np)
     real(wp), allocatable :: vol(:)      !! volumes (np)
     real(wp), allocatable :: rho(:)      !! densities (np)
+    integer, allocatable :: id(:)        !! the particles' ids (np): the columns' order
     real(wp), allocatable :: state(:,:)  !! materials' state variables (nstate, np), as
                                          !! `pts%state`
   end type empm_snapshot_t
@@ -193,5 +194,6 @@ contains
     self%snap(k)%stress = pts%stress(:, 1:n); self%snap(k)%strain = pts%strain(:, 1:n)
     self%snap(k)%m = pts%m(1:n); self%snap(k)%vol = pts%vol(1:n); self%snap(k)%rho = pts%rho(1:n)
     self%snap(k)%state = pts%state(:, 1:n)
+    self%snap(k)%id = pts%id(1:n)
   end subroutine history_add_snapshot
 end module empm_history

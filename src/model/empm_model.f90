@@ -49,6 +49,9 @@ module empm_model
     type(empm_comm_t) :: comm                           !! the processes sharing the run: each
                                                         !! holds its particles, all the grid
                                                         !! (docs/parallel.md); serial default
+    integer, allocatable :: boxes(:,:,:)                !! the processes' boxes of cells,
+                                                        !! first and last cell (3, 2, nranks)
+    integer, allocatable :: boxes0(:,:,:)               !! the first ones (a static split's)
     integer, allocatable :: run_first(:)                !! particle runs with one material: first
     integer, allocatable :: run_last(:)                 !! ... last particle of the run
     real(wp) :: t = 0.0_wp                              !! current time [s]

@@ -9,7 +9,7 @@ module empm_partition
   use empm_decomp, only: empm_rcb, empm_cell_of, empm_box_owner
   implicit none
   private
-  public :: empm_partition_particles, empm_gather_particles
+  public :: empm_partition_particles, empm_gather_particles, empm_rebalance
 
 contains
 
@@ -65,7 +65,130 @@ contains
       call empm_raise_error(e, err); return
     end if
     model%nodes%mass_tol = mass_tol
+    call keep_boxes(model, lo, hi)
+    model%boxes0 = model%boxes
   end subroutine empm_partition_particles
+
+  ! The boxes as (3, 2, nranks): first and last cell of each process's.
+  subroutine keep_boxes(model, lo, hi)
+    type(empm_model_t), intent(inout) :: model
+    integer, intent(in) :: lo(:,:), hi(:,:)
+    if (allocated(model%boxes)) deallocate(model%boxes)
+    allocate(model%boxes(3, 2, size(lo, 2)))
+    model%boxes(:, 1, :) = lo; model%boxes(:, 2, :) = hi
+  end subroutine keep_boxes
+
+  !> Cut the boxes again from where the particles are now, and move every particle to the
+  !> process of its box (each process's particles then in id order). `before` and `static`
+  !> report the largest process's share over the mean: in the boxes being replaced, and in the
+  !> first ones (what a split never re-cut would hold). Not with surface tractions (their
+  !> particle lists stay as they are: `moved` false). Serial: nothing changes.
+  subroutine empm_rebalance(model, before, static, moved, err)
+    type(empm_model_t), intent(inout) :: model          !! model (shared among processes)
+    real(wp), intent(out) :: before                     !! max/mean in the boxes replaced
+    real(wp), intent(out) :: static                     !! max/mean in the first boxes
+    logical, intent(out) :: moved                       !! the particles were redistributed
+    type(empm_error_t), intent(inout), optional :: err  !! allocation failure, if present
+    type(empm_error_t) :: e
+    real(wp), allocatable :: cnt(:), rows(:,:), got(:,:), srt(:,:)
+    integer, allocatable :: counts(:), dest(:), order(:)
+    integer :: lo(3, model%comm%nranks), hi(3, model%comm%nranks), ijk(3), nc(3)
+    integer :: p, np, c, m, oid, nd, ns, n
+    real(wp) :: mass_tol
+    before = 1.0_wp; static = 1.0_wp; moved = .false.
+    if (.not. model%comm%parallel() .or. .not. allocated(model%boxes)) return
+    if (model%loads%ntraction() > 0) return
+    np = model%pts%np; nd = model%grid%ndim; ns = model%pts%nstate
+    nc = 1
+    nc(1:nd) = model%grid%ncell(1:nd)
+    ! Particles per cell over all processes (exact in reals).
+    allocate(cnt(product(nc)))
+    cnt = 0.0_wp
+    do p = 1, np
+      ijk = empm_cell_of(model%grid, model%pts%x(:, p))
+      c = ijk(1) + nc(1) * ((ijk(2) - 1) + nc(2) * (ijk(3) - 1))
+      cnt(c) = cnt(c) + 1.0_wp
+    end do
+    call model%comm%sum(cnt)
+    counts = nint(cnt)
+    before = share(model%boxes)
+    static = share(model%boxes0)
+    call empm_rcb(nd, nc(1:nd), counts, model%comm%nranks, lo, hi)
+    call keep_boxes(model, lo, hi)
+    ! Every particle to the process of its box.
+    m = model%pts%row_size()
+    allocate(rows(m, np), dest(np))
+    call model%pts%pack_rows([(p, p = 1, np)], rows)
+    do p = 1, np
+      dest(p) = empm_box_owner(lo, hi, empm_cell_of(model%grid, model%pts%x(:, p))) - 1
+    end do
+    call model%comm%exchange_rows(rows, np, dest, got)
+    ! In id order, as the set was made (runs of one material stay together).
+    oid = model%pts%id_row()
+    n = size(got, 2)
+    order = id_order(nint(got(oid, 1:n)))
+    allocate(srt(m, n))
+    srt = got(:, order)
+    mass_tol = model%nodes%mass_tol
+    call model%pts%set_from_rows(nd, ns, srt, n, e)
+    if (e%code == 0) call model%set_runs(e)
+    if (e%code /= 0) then
+      call empm_raise_error(e, err); return
+    end if
+    model%nodes%mass_tol = mass_tol
+    moved = .true.
+
+  contains
+
+    ! Largest process's share of the particles over the mean, in the boxes b.
+    real(wp) function share(b)
+      integer, intent(in) :: b(:,:,:)
+      real(wp) :: per(size(b, 3))
+      integer :: q, i, j, k
+      per = 0.0_wp
+      do q = 1, size(b, 3)
+        do k = b(3, 1, q), b(3, 2, q)
+          do j = b(2, 1, q), b(2, 2, q)
+            do i = b(1, 1, q), b(1, 2, q)
+              per(q) = per(q) + cnt(i + nc(1) * ((j - 1) + nc(2) * (k - 1)))
+            end do
+          end do
+        end do
+      end do
+      share = maxval(per) / max(sum(per) / size(per), 1.0_wp)
+    end function share
+  end subroutine empm_rebalance
+
+  ! The permutation that sorts distinct integers increasingly (merge sort: n log n, stable).
+  pure function id_order(key) result(idx)
+    integer, intent(in) :: key(:)
+    integer :: idx(size(key))
+    integer :: tmp(size(key)), width, lo, mid, hi, i, j, k, n
+    n = size(key)
+    idx = [(i, i = 1, n)]
+    width = 1
+    do while (width < n)
+      lo = 1
+      do while (lo <= n)
+        mid = min(lo + width - 1, n); hi = min(lo + 2 * width - 1, n)
+        i = lo; j = mid + 1; k = lo
+        do while (i <= mid .and. j <= hi)
+          if (key(idx(j)) < key(idx(i))) then
+            tmp(k) = idx(j); j = j + 1
+          else
+            tmp(k) = idx(i); i = i + 1
+          end if
+          k = k + 1
+        end do
+        tmp(k:k + mid - i) = idx(i:mid); k = k + mid - i + 1
+        tmp(k:k + hi - j) = idx(j:hi)
+        lo = lo + 2 * width
+      end do
+      idx = tmp
+      width = 2 * width
+    end do
+  end function id_order
+
   ! A snapshot of every particle keeps the columns `mine`.
   subroutine keep_snapshot(sn, mine)
     type(empm_snapshot_t), intent(inout) :: sn
@@ -73,7 +196,7 @@ contains
     sn%x = sn%x(:, mine); sn%v = sn%v(:, mine)
     sn%stress = sn%stress(:, mine); sn%strain = sn%strain(:, mine)
     sn%m = sn%m(mine); sn%vol = sn%vol(mine); sn%rho = sn%rho(mine)
-    sn%state = sn%state(:, mine)
+    sn%state = sn%state(:, mine); sn%id = sn%id(mine)
   end subroutine keep_snapshot
 
   ! Each traction keeps the loaded particles this process holds, renumbered as they will be.
@@ -122,10 +245,8 @@ contains
     real(wp), allocatable :: rows(:,:), all(:,:), sorted(:,:)
     type(empm_error_t) :: e
     integer :: m, np, k, nd, ns, oid
-    integer, allocatable :: ids(:)
     if (.not. model%comm%parallel()) return
     np = model%pts%np; nd = model%grid%ndim; ns = model%pts%nstate
-    ids = model%pts%id(1:np)
     do k = 1, hist%nsnap
       call gather_snapshot(hist%snap(k))
     end do
@@ -134,7 +255,7 @@ contains
     call model%pts%pack_rows([(k, k = 1, np)], rows)
     call model%comm%gather_rows(rows, np, all)
     if (.not. model%comm%is_root()) return
-    oid = m - ns ! the id's row (pack_rows)
+    oid = model%pts%id_row()
     allocate(sorted(m, size(all, 2)))
     do k = 1, size(all, 2)
       sorted(:, nint(all(oid, k))) = all(:, k)
@@ -148,22 +269,24 @@ contains
 
   contains
 
-    ! One snapshot's particles (taken in this process's current order, `ids`).
+    ! One snapshot's particles (in the order of its ids: the process's particles when it was
+    ! taken).
     subroutine gather_snapshot(sn)
       type(empm_snapshot_t), intent(inout) :: sn
       real(wp), allocatable :: r(:,:), a(:,:), srt(:,:)
-      integer :: mm, q, o
+      integer :: mm, q, o, n
       mm = 1 + 2 * nd + 12 + 3 + ns
-      allocate(r(mm, np))
-      do q = 1, np
-        r(1, q) = real(ids(q), wp)
+      n = size(sn%id) ! the particles it held then (before a re-cut, perhaps)
+      allocate(r(mm, n))
+      do q = 1, n
+        r(1, q) = real(sn%id(q), wp)
         r(2:1 + nd, q) = sn%x(:, q); r(2 + nd:1 + 2 * nd, q) = sn%v(:, q)
         o = 1 + 2 * nd
         r(o + 1:o + 6, q) = sn%stress(:, q); r(o + 7:o + 12, q) = sn%strain(:, q)
         r(o + 13, q) = sn%m(q); r(o + 14, q) = sn%vol(q); r(o + 15, q) = sn%rho(q)
         r(o + 16:o + 15 + ns, q) = sn%state(:, q)
       end do
-      call model%comm%gather_rows(r, np, a)
+      call model%comm%gather_rows(r, n, a)
       if (.not. model%comm%is_root()) return
       allocate(srt(mm, size(a, 2)))
       do q = 1, size(a, 2)
@@ -174,6 +297,7 @@ contains
       sn%stress = srt(o + 1:o + 6, :); sn%strain = srt(o + 7:o + 12, :)
       sn%m = srt(o + 13, :); sn%vol = srt(o + 14, :); sn%rho = srt(o + 15, :)
       sn%state = srt(o + 16:o + 15 + ns, :)
+      sn%id = [(q, q = 1, size(srt, 2))]
     end subroutine gather_snapshot
   end subroutine empm_gather_particles
 end module empm_partition

@@ -42,6 +42,11 @@ module empm_particles
     real(wp), allocatable :: lam_prev(:,:)  !! `lam` before the last evaluation (ndim, np): with
     real(wp), allocatable :: lam_old_prev(:,:) !! this, what that evaluation started from
                                             !! ([[particles_rewind_shape_state]])
+    real(wp), allocatable :: vol_fill(:)    !! the volumes the last basis evaluation filled
+                                            !! the nodes with (np) [m³]: a scheme that carries
+                                            !! its basis into the next step finds its
+                                            !! nearly-empty nodes from them, and so must an
+                                            !! evaluation that repeats it (a restart)
     integer, allocatable :: mat(:)          !! material index (np)
     integer, allocatable :: id(:)           !! the particle's number in generation order (np):
                                             !! its place in the output whichever process
@@ -56,6 +61,7 @@ module empm_particles
     procedure :: rewind_shape_state => particles_rewind_shape_state
     procedure :: material_fields_fine => particles_material_fields_fine
     procedure :: row_size => particles_row_size
+    procedure :: id_row => particles_id_row
     procedure :: pack_rows => particles_pack_rows
     procedure :: set_from_rows => particles_set_from_rows
     procedure :: keep => particles_keep
@@ -113,11 +119,11 @@ contains
       self%m(n), self%vol(n), self%vol0(n), self%rho(n), self%stress(6, n), self%strain(6, n), &
       self%F(3, 3, n), self%lp(ndim, n), self%lam(ndim, n), &
       self%lam_old(ndim, n), self%lam_prev(ndim, n), self%lam_old_prev(ndim, n), self%mat(n), &
-      self%id(n), self%state(ns, n), stat=st, errmsg=msg)
+      self%id(n), self%vol_fill(n), self%state(ns, n), stat=st, errmsg=msg)
     if (st /= 0) then
       call release(self)
       ! 10 vectors, 4 scalars, 2 Voigt tensors, F and the state in reals; the material index.
-      bytes = int(n, int64) * (8_int64 * (10 * ndim + 4 + 12 + 9 + int(ns, int64)) + 8_int64)
+      bytes = int(n, int64) * (8_int64 * (10 * ndim + 5 + 12 + 9 + int(ns, int64)) + 8_int64)
       call empm_raise_error(empm_alloc_error('particle storage ('//str(n)//' particles)', &
         bytes, trim(msg)), err)
       return
@@ -170,6 +176,7 @@ contains
     if (allocated(self%lam_old_prev)) deallocate(self%lam_old_prev)
     if (allocated(self%mat)) deallocate(self%mat)
     if (allocated(self%id)) deallocate(self%id)
+    if (allocated(self%vol_fill)) deallocate(self%vol_fill)
     if (allocated(self%state)) deallocate(self%state)
   end subroutine release
 
@@ -208,6 +215,7 @@ contains
     self%x(:, n) = x(1:d); self%x0(:, n) = x(1:d)
     self%v(:, n) = 0.0_wp; self%a(:, n) = 0.0_wp; self%dx(:, n) = 0.0_wp
     self%vol(n) = vol; self%vol0(n) = vol; self%rho(n) = rho; self%m(n) = rho * vol
+    self%vol_fill(n) = vol
     self%stress(:, n) = 0.0_wp; self%strain(:, n) = 0.0_wp
     self%F(:, :, n) = 0.0_wp; self%F(1, 1, n) = 1.0_wp; self%F(2, 2, n) = 1.0_wp
     self%F(3, 3, n) = 1.0_wp
@@ -244,6 +252,7 @@ contains
     self%lam_old_prev(:, 1:n) = src%lam_old_prev(:, 1:n)
     self%mat(1:n) = src%mat(1:n)
     self%id(1:n) = src%id(1:n)
+    self%vol_fill(1:n) = src%vol_fill(1:n)
   end subroutine particles_copy_state
 
   !> Put the shape state (the LME multipliers) back to what the last basis evaluation started
@@ -259,8 +268,14 @@ contains
   !> Number of reals that hold one particle in a row ([[particles_pack_rows]]).
   pure integer function particles_row_size(self) result(m)
     class(empm_particles_t), intent(in) :: self !! particles
-    m = 10 * self%ndim + 4 + 12 + 9 + 2 + self%nstate
+    m = 10 * self%ndim + 4 + 12 + 9 + 3 + self%nstate
   end function particles_row_size
+
+  !> The row of [[particles_pack_rows]] that holds a particle's id.
+  pure integer function particles_id_row(self) result(r)
+    class(empm_particles_t), intent(in) :: self !! particles
+    r = 10 * self%ndim + 27
+  end function particles_id_row
 
   !> rows(:, k) = every field of particle idx(k), as reals (the material index and the id are
   !> exact in a real): what moves a particle between processes or gathers them for output.
@@ -284,7 +299,8 @@ contains
       rows(o + 5:o + 10, k) = self%stress(:, p); rows(o + 11:o + 16, k) = self%strain(:, p)
       rows(o + 17:o + 25, k) = reshape(self%F(:, :, p), [9])
       rows(o + 26, k) = real(self%mat(p), wp); rows(o + 27, k) = real(self%id(p), wp)
-      rows(o + 28:o + 27 + self%nstate, k) = self%state(:, p)
+      rows(o + 28, k) = self%vol_fill(p)
+      rows(o + 29:o + 28 + self%nstate, k) = self%state(:, p)
     end do
   end subroutine particles_pack_rows
 
@@ -316,7 +332,8 @@ contains
       self%stress(:, k) = rows(o + 5:o + 10, k); self%strain(:, k) = rows(o + 11:o + 16, k)
       self%F(:, :, k) = reshape(rows(o + 17:o + 25, k), [3, 3])
       self%mat(k) = nint(rows(o + 26, k)); self%id(k) = nint(rows(o + 27, k))
-      self%state(:, k) = rows(o + 28:o + 27 + nstate, k)
+      self%vol_fill(k) = rows(o + 28, k)
+      self%state(:, k) = rows(o + 29:o + 28 + nstate, k)
     end do
     self%np = n
   end subroutine particles_set_from_rows
@@ -339,7 +356,7 @@ contains
       self%lp(:, k) = self%lp(:, p); self%lam(:, k) = self%lam(:, p)
       self%lam_old(:, k) = self%lam_old(:, p); self%lam_prev(:, k) = self%lam_prev(:, p)
       self%lam_old_prev(:, k) = self%lam_old_prev(:, p)
-      self%mat(k) = self%mat(p); self%id(k) = self%id(p)
+      self%mat(k) = self%mat(p); self%id(k) = self%id(p); self%vol_fill(k) = self%vol_fill(p)
       if (self%nstate > 0) self%state(:, k) = self%state(:, p)
     end do
     self%np = size(idx)
@@ -362,6 +379,7 @@ contains
     call move_alloc(from%lam_old_prev, to%lam_old_prev)
     call move_alloc(from%mat, to%mat)
     call move_alloc(from%id, to%id)
+    call move_alloc(from%vol_fill, to%vol_fill)
     to%nstate = from%nstate
     call move_alloc(from%state, to%state)
   end subroutine move_alloc_all

@@ -7,6 +7,7 @@ module empm_solver
   use empm_error, only: empm_error_t, empm_raise, empm_raise_error, empm_alloc_error, &
                         EMPM_ERR_RUNTIME, EMPM_ERR_USAGE, EMPM_ERR_INTERRUPTED
   use empm_strings, only: str, join
+  use empm_partition, only: empm_rebalance
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK, STEP_SHAPE_FAILED
   use empm_loads, only: RAMP_NONE
   use empm_integrator, only: empm_integrator_t
@@ -93,6 +94,11 @@ module empm_solver
     real(wp) :: residual = -1.0_wp      !! its last value (model%residual)
                                         !! (trapezoidal per step): what the total energy
                                         !! gains from a gravity ramp
+    integer :: nranks = 1               !! processes that ran it
+    integer :: rebalances = 0           !! times the processes' boxes were cut again
+    real(wp) :: imbalance = 1.0_wp      !! largest process's particles over the mean, just
+                                        !! before a re-cut (the worst the boxes drifted to)
+    real(wp) :: imbalance_static = 1.0_wp !! the same in the first boxes (a split never re-cut)
   end type empm_run_stats_t
 
 contains
@@ -204,7 +210,11 @@ contains
     ! steps since with their recorded time steps, which gives the state before the failing
     ! step bitwise (the step is deterministic for a given number of threads).
     integer, parameter :: KEEP_EVERY = 128
+    ! On several processes the boxes are cut again at every kept state, every RECUT_EVERY
+    ! steps: a collapsing body drifts out of balance within a few tens of steps.
+    integer, parameter :: RECUT_EVERY = 32
     real(wp) :: dts(KEEP_EVERY), t_prev
+    integer :: keep
     real(wp), allocatable :: xprev(:,:)
     integer :: nrep
     logical :: ramping
@@ -215,7 +225,7 @@ contains
     type(empm_step_status_t) :: stat
     real(wp), allocatable :: psi(:)
     real(wp) :: dt, dt_stable, ekin, estr, egrav, t_good, t_next_snap
-    integer :: isnap, nsnap, step_good
+    integer :: isnap, nsnap, step_good, step_first
     integer(int64) :: clock0, clock_last, clock, rate
     logical :: show, tty, sample, suspect, summed
     type(empm_run_stats_t) :: st
@@ -279,7 +289,11 @@ contains
     ! Plain lines (logs, pipes) are written when t passes the next tenth of the run.
     t_report = model%t + 0.1_wp * (cfg%t_end - model%t)
     call system_clock(clock0, rate); clock_last = clock0; clock_ckpt = clock0
-    nrep = KEEP_EVERY ! a copy before the first step
+    keep = KEEP_EVERY
+    if (model%comm%parallel()) keep = RECUT_EVERY
+    nrep = keep ! a copy before the first step
+    step_first = model%step
+    st%nranks = model%comm%nranks
     ! The work of a time-varying gravity needs the positions before each step.
     ramping = model%loads%ramp /= RAMP_NONE
     if (ramping) allocate(xprev(model%grid%ndim, model%pts%np))
@@ -313,7 +327,15 @@ contains
       if (isnap <= nsnap) t_next_snap = min(cfg%t_end, cfg%snapshot_times(isnap))
       if (model%t + dt > t_next_snap * (1.0_wp - 1.0e-12_wp)) dt = t_next_snap - model%t
 
-      if (nrep == KEEP_EVERY) then
+      if (nrep == keep) then
+        ! Several processes: the boxes follow the particles (before the kept state, so that a
+        ! guard's replay never crosses a re-cut).
+        if (model%comm%parallel() .and. model%step > step_first) then
+          call rebalance(e)
+          if (e%code /= 0) then
+            call finish_stats(); call empm_raise_error(e, err); return
+          end if
+        end if
         call good%copy_state_from(model%pts)
         call save_tractions()
         t_good = model%t; step_good = model%step; nrep = 0
@@ -450,6 +472,36 @@ contains
         end associate
       end do
     end subroutine restore_tractions
+
+    ! Cut the processes' boxes again and move the particles; then the work arrays sized by
+    ! the number of particles, as a restart makes them (the integrator's start-up changes the
+    ! particles: they are put back).
+    subroutine rebalance(ec)
+      type(empm_error_t), intent(out) :: ec
+      real(wp) :: before, static, res0
+      logical :: moved
+      call empm_rebalance(model, before, static, moved, ec)
+      if (ec%code /= 0 .or. .not. moved) return
+      st%rebalances = st%rebalances + 1
+      st%imbalance = max(st%imbalance, before)
+      st%imbalance_static = max(st%imbalance_static, static)
+      call hist%locate_probes(model%pts)
+      call good%alloc(model%grid%ndim, model%pts%np, model%pts%nstate, ec)
+      if (ec%code /= 0) return
+      call good%copy_state_from(model%pts)
+      res0 = model%residual
+      call integ%prepare(model, ec)
+      if (ec%code /= 0) return
+      call model%pts%copy_state_from(good)
+      call integ%resync(model)
+      model%residual = res0
+      deallocate(psi, model%diag_psi)
+      allocate(psi(model%pts%np), model%diag_psi(model%pts%np))
+      model%diag_step = -1
+      if (ramping) then
+        deallocate(xprev); allocate(xprev(model%grid%ndim, model%pts%np))
+      end if
+    end subroutine rebalance
 
     ! The potential −Σ m g(t)·x changes with g(t) too: the ramp's work, so that the energy
     ! balance of the summary can subtract it. Diagnostics only (the state is not touched).
@@ -865,6 +917,13 @@ contains
     if (st%tracked) then
       write(e0, '(es10.3)') st%residual
       s = s//'; residual '//trim(adjustl(e0))
+    end if
+    if (st%nranks > 1) then
+      write(e0, '(f8.3)') st%imbalance
+      write(e1, '(f8.3)') st%imbalance_static
+      s = s//'; '//str(st%nranks)//' processes, '//str(st%rebalances)//' re-cuts, particles '// &
+        'per process at most '//trim(adjustl(e0))//' x the mean (never re-cut: '// &
+        trim(adjustl(e1))//')'
     end if
   end function empm_run_summary
 
