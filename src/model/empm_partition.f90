@@ -81,8 +81,9 @@ contains
   !> Cut the boxes again from where the particles are now, and move every particle to the
   !> process of its box (each process's particles then in id order). `before` and `static`
   !> report the largest process's share over the mean: in the boxes being replaced, and in the
-  !> first ones (what a split never re-cut would hold). Not with surface tractions (their
-  !> particle lists stay as they are: `moved` false). Serial: nothing changes.
+  !> first ones (what a split never re-cut would hold). `moved` is false when no particle
+  !> changed process (the new boxes are kept), and with surface tractions (their particle lists
+  !> stay as they are, and so do the boxes). Serial: nothing changes.
   subroutine empm_rebalance(model, before, static, moved, err)
     type(empm_model_t), intent(inout) :: model          !! model (shared among processes)
     real(wp), intent(out) :: before                     !! max/mean in the boxes replaced
@@ -115,13 +116,15 @@ contains
     static = share(model%boxes0)
     call empm_rcb(nd, nc(1:nd), counts, model%comm%nranks, lo, hi)
     call keep_boxes(model, lo, hi)
-    ! Every particle to the process of its box.
-    m = model%pts%row_size()
-    allocate(rows(m, np), dest(np))
-    call model%pts%pack_rows([(p, p = 1, np)], rows)
+    ! Every particle to the process of its box; nothing to do when none changes process.
+    allocate(dest(np))
     do p = 1, np
       dest(p) = empm_box_owner(lo, hi, empm_cell_of(model%grid, model%pts%x(:, p))) - 1
     end do
+    if (model%comm%sum_int(count(dest /= model%comm%rank)) == 0) return
+    m = model%pts%row_size()
+    allocate(rows(m, np))
+    call model%pts%pack_rows([(p, p = 1, np)], rows)
     call model%comm%exchange_rows(rows, np, dest, got)
     ! In id order, as the set was made (runs of one material stay together).
     oid = model%pts%id_row()

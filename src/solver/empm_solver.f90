@@ -95,7 +95,8 @@ module empm_solver
                                         !! (trapezoidal per step): what the total energy
                                         !! gains from a gravity ramp
     integer :: nranks = 1               !! processes that ran it
-    integer :: rebalances = 0           !! times the processes' boxes were cut again
+    integer :: rebalances = 0           !! times particles moved to other processes after a
+                                        !! re-cut of the boxes
     real(wp) :: imbalance = 1.0_wp      !! largest process's particles over the mean, just
                                         !! before a re-cut (the worst the boxes drifted to)
     real(wp) :: imbalance_static = 1.0_wp !! the same in the first boxes (a split never re-cut)
@@ -481,10 +482,11 @@ contains
       real(wp) :: before, static, res0
       logical :: moved
       call empm_rebalance(model, before, static, moved, ec)
-      if (ec%code /= 0 .or. .not. moved) return
-      st%rebalances = st%rebalances + 1
+      if (ec%code /= 0) return
       st%imbalance = max(st%imbalance, before)
       st%imbalance_static = max(st%imbalance_static, static)
+      if (.not. moved) return
+      st%rebalances = st%rebalances + 1
       call hist%locate_probes(model%pts)
       call good%alloc(model%grid%ndim, model%pts%np, model%pts%nstate, ec)
       if (ec%code /= 0) return
