@@ -1,0 +1,103 @@
+#!/usr/bin/python3
+"""Cost model of a parallel empm step (docs/parallel.md, issue 18 item 6): strong and weak
+scaling to 1,024 processes of a 3D LME case with 1e8 particles, for the block-local design
+(each process its box of cells plus ghost node layers, shared nodes summed with its 26
+neighbours), from a measured per-particle cost and the network figures of a typical cluster.
+It models the design the docs describe as the next stage, not today's replicated grid (whose
+whole-grid sums the last columns show for comparison).
+
+Usage: mpi_cost_model.py [--alpha-us 1.5] [--gbytes 12.5] [--node 0.78] [--imbalance 1.05]
+  --alpha-us  message latency [us]; --gbytes link bandwidth [GB/s] (InfiniBand HDR100-class)
+  --node      a process's speed when every core of its node is busy, over its speed alone:
+              measured 0.78 for the 2D linear step (benchmarks/mpi_scaling.py, 2 processes on
+              this 2-core machine: memory bandwidth shared); a compute-bound LME step loses less
+  --imbalance the largest process's particles over the mean (measured 1.14-1.20 on small
+              collapsing columns, tests/mpi/balance.py; the cut's grain shrinks with size)
+Two per-particle costs of one core, both measured (reports/performance.md): 3D LME gamma = 3
+with real motion (empm bench --motion rotate, 1.43e5 particle-steps/s: 7.0 us), and 3D linear
+shapes (3.94e6 particle-steps/s: 0.25 us), with 3 and 1 ghost node layers.
+"""
+import math
+import sys
+
+
+def opt(name, default):
+    if name in sys.argv:
+        return type(default)(sys.argv[sys.argv.index(name) + 1])
+    return default
+
+
+ALPHA = opt("--alpha-us", 1.5) * 1e-6       # s per message
+BETA = 1.0 / (opt("--gbytes", 12.5) * 1e9)  # s per byte
+NODE = opt("--node", 0.78)                  # on-node speed factor with every core busy
+IMB = opt("--imbalance", 1.05)              # largest process's share over the mean
+COST, W = 7.0e-6, 3                         # set per table in main()
+PPC = 8                                     # particles per cell (2 per direction)
+ROW = 8 * (10 * 3 + 4 + 12 + 9 + 3 + 2)     # bytes of a migrating particle (pack_rows, 2 state)
+CROSS = 0.01                                # share of a block's surface particles that cross
+                                            # a face per step (fast flow: 1 % of a cell a step)
+# Per step of pc_newmark: two rounds of nodal sums (mass, momentum and filled volume after the
+# drift: 5 doubles a node; forces of the kick: 3), plus 2 global reductions (dt, energies).
+SUMS = (5, 3)
+
+
+def step_time(n_particles, procs):
+    """(compute, halo, migration, reductions, replicated-grid sums) in seconds a step."""
+    n = n_particles / procs
+    cells = n / PPC
+    m = cells ** (1.0 / 3.0)                 # cells a side of a cubic block
+    # The slowest process: the largest share, at the speed of a full node.
+    compute = n * COST * (IMB / NODE if procs > 1 else 1.0)
+    # Shared nodes: the 6 faces, 12 edges and 8 corners of the block, W layers deep.
+    halo_nodes = 6 * (m + 1) ** 2 * W + 12 * (m + 1) * W * W + 8 * W ** 3
+    halo = 0.0
+    if procs > 1:
+        for doubles in SUMS:
+            # Each neighbour's share sent and received once (26 messages each way).
+            halo += 26 * ALPHA + 2 * halo_nodes * doubles * 8 * BETA
+    surface = 6 * m * m * PPC ** (2.0 / 3.0)  # particles in the block's outer cell layer
+    migration = (26 * ALPHA + CROSS * surface * ROW * BETA) if procs > 1 else 0.0
+    reductions = 2 * math.ceil(math.log2(procs)) * ALPHA if procs > 1 else 0.0
+    nodes_all = n_particles / PPC
+    replicated = 0.0
+    if procs > 1:
+        # Today's design: every nodal array summed in full (ring allreduce: 2 (P-1)/P of it).
+        replicated = sum(2 * (procs - 1) / procs * nodes_all * d * 8 * BETA
+                         + 2 * math.ceil(math.log2(procs)) * ALPHA for d in SUMS)
+    return compute, halo, migration, reductions, replicated
+
+
+def table(title, rows):
+    print(title)
+    print(f"{'P':>5} {'particles/P':>12} {'step [ms]':>10} {'compute':>8} {'halo':>8} "
+          f"{'migr.':>7} {'reduce':>7} {'eff.':>6} {'eff. (replicated grid)':>23}")
+    for procs, n_total, t1 in rows:
+        c, h, mg, r, rep = step_time(n_total, procs)
+        t = c + h + mg + r
+        eff = t1 / t if t1 else c / t
+        trep = c + rep + r
+        eff_rep = t1 / trep if t1 else c / trep
+        print(f"{procs:5d} {n_total / procs:12.3g} {1e3 * t:10.3f} {c / t:8.1%} {h / t:8.1%} "
+              f"{mg / t:7.1%} {r / t:7.1%} {eff:6.2f} {eff_rep:23.2f}")
+    print()
+
+
+def main():
+    global COST, W
+    print(f"latency {ALPHA * 1e6:.1f} us, {1 / BETA / 1e9:.1f} GB/s; on-node factor {NODE}; "
+          f"imbalance {IMB}; {PPC} particles per cell\n")
+    procs = [1, 2, 8, 64, 128, 256, 512, 1024]
+    for label, cost, width in [("3D LME gamma = 3 (7.0 us a particle-step)", 7.0e-6, 3),
+                               ("3D linear (0.25 us a particle-step)", 0.254e-6, 1)]:
+        COST, W = cost, width
+        big = 1.0e8
+        t_one = step_time(big, 1)[0]
+        table(f"{label}: strong scaling, 1e8 particles (efficiency = T1 / (P T_P))",
+              [(p, big, t_one / p) for p in procs])
+        per = 2.5e5
+        table(f"{label}: weak scaling, 2.5e5 particles per process (efficiency = T1 / T_P)",
+              [(p, per * p, step_time(per, 1)[0]) for p in procs])
+
+
+if __name__ == "__main__":
+    main()
