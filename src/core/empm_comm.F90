@@ -42,6 +42,7 @@ module empm_comm
     procedure :: max_real => comm_max_real
     procedure :: min_real => comm_min_real
     procedure :: sum_int => comm_sum_int
+    procedure :: sum_counts => comm_sum_counts
     procedure :: max_int => comm_max_int
     procedure :: min_int => comm_min_int
     procedure :: bcast_ints => comm_bcast_ints
@@ -144,6 +145,16 @@ contains
     call MPI_Allreduce(MPI_IN_PLACE, a, n, MPI_DOUBLE_PRECISION, MPI_SUM, self%handle)
 #endif
   end subroutine sum_buffer
+
+  !> c ← Σ over the processes of c (integer counts, every process gets the sum).
+  subroutine comm_sum_counts(self, c)
+    class(empm_comm_t), intent(in) :: self      !! communicator
+    integer, intent(inout), contiguous :: c(:)  !! counts, summed in place
+    if (self%nranks <= 1 .or. size(c) == 0) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(MPI_IN_PLACE, c, size(c), MPI_INTEGER, MPI_SUM, self%handle)
+#endif
+  end subroutine comm_sum_counts
 
   !> Σ over the processes of x.
   function comm_sum_real(self, x) result(s)

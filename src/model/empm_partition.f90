@@ -25,29 +25,18 @@ contains
                                                         !! this process's particles too
     type(empm_error_t) :: e
     integer, allocatable :: counts(:), mine(:), owner(:)
-    integer :: lo(3, model%comm%nranks), hi(3, model%comm%nranks), ijk(3), nc(3)
-    integer :: p, np, n, c
+    integer :: lo(3, model%comm%nranks), hi(3, model%comm%nranks), nc(3)
+    integer :: p, n
     real(wp) :: mass_tol
     if (.not. model%comm%parallel()) return
-    np = model%pts%np
-    nc = 1
-    nc(1:model%grid%ndim) = model%grid%ncell(1:model%grid%ndim)
-    allocate(counts(product(nc)), owner(np))
-    counts = 0
-    do p = 1, np
-      ijk = empm_cell_of(model%grid, model%pts%x(:, p))
-      c = ijk(1) + nc(1) * ((ijk(2) - 1) + nc(2) * (ijk(3) - 1))
-      counts(c) = counts(c) + 1
-    end do
+    ! Every process holds every particle here: its own counts are the whole run's.
+    call cell_counts(model, nc, counts)
     call empm_rcb(model%grid%ndim, nc(1:model%grid%ndim), counts, model%comm%nranks, lo, hi)
-    n = 0
-    do p = 1, np
-      owner(p) = empm_box_owner(lo, hi, empm_cell_of(model%grid, model%pts%x(:, p))) - 1
-      if (owner(p) == model%comm%rank) n = n + 1
-    end do
+    owner = owners(model, lo, hi)
+    n = count(owner == model%comm%rank)
     allocate(mine(n))
     n = 0
-    do p = 1, np
+    do p = 1, model%pts%np
       if (owner(p) == model%comm%rank) then
         n = n + 1; mine(n) = p
       end if
@@ -68,6 +57,35 @@ contains
     call keep_boxes(model, lo, hi)
     model%boxes0 = model%boxes
   end subroutine empm_partition_particles
+
+  ! The particles this process holds in each cell (direction 1 fastest), and the cells per
+  ! direction (1 beyond ndim).
+  subroutine cell_counts(model, nc, counts)
+    type(empm_model_t), intent(in) :: model
+    integer, intent(out) :: nc(3)
+    integer, allocatable, intent(out) :: counts(:)
+    integer :: p, ijk(3), c
+    nc = 1
+    nc(1:model%grid%ndim) = model%grid%ncell(1:model%grid%ndim)
+    allocate(counts(product(nc)))
+    counts = 0
+    do p = 1, model%pts%np
+      ijk = empm_cell_of(model%grid, model%pts%x(:, p))
+      c = ijk(1) + nc(1) * ((ijk(2) - 1) + nc(2) * (ijk(3) - 1))
+      counts(c) = counts(c) + 1
+    end do
+  end subroutine cell_counts
+
+  ! The process (from 0) whose box holds each particle's cell.
+  function owners(model, lo, hi) result(dest)
+    type(empm_model_t), intent(in) :: model
+    integer, intent(in) :: lo(:,:), hi(:,:)
+    integer :: dest(model%pts%np)
+    integer :: p
+    do p = 1, model%pts%np
+      dest(p) = empm_box_owner(lo, hi, empm_cell_of(model%grid, model%pts%x(:, p))) - 1
+    end do
+  end function owners
 
   ! The boxes as (3, 2, nranks): first and last cell of each process's.
   subroutine keep_boxes(model, lo, hi)
@@ -91,36 +109,23 @@ contains
     logical, intent(out) :: moved                       !! the particles were redistributed
     type(empm_error_t), intent(inout), optional :: err  !! allocation failure, if present
     type(empm_error_t) :: e
-    real(wp), allocatable :: cnt(:), rows(:,:), got(:,:), srt(:,:)
+    real(wp), allocatable :: rows(:,:), got(:,:), srt(:,:)
     integer, allocatable :: counts(:), dest(:), order(:)
-    integer :: lo(3, model%comm%nranks), hi(3, model%comm%nranks), ijk(3), nc(3)
-    integer :: p, np, c, m, oid, nd, ns, n
+    integer :: lo(3, model%comm%nranks), hi(3, model%comm%nranks), nc(3)
+    integer :: p, np, m, oid, nd, ns, n
     real(wp) :: mass_tol
     before = 1.0_wp; static = 1.0_wp; moved = .false.
     if (.not. model%comm%parallel() .or. .not. allocated(model%boxes)) return
     if (model%loads%ntraction() > 0) return
     np = model%pts%np; nd = model%grid%ndim; ns = model%pts%nstate
-    nc = 1
-    nc(1:nd) = model%grid%ncell(1:nd)
-    ! Particles per cell over all processes (exact in reals).
-    allocate(cnt(product(nc)))
-    cnt = 0.0_wp
-    do p = 1, np
-      ijk = empm_cell_of(model%grid, model%pts%x(:, p))
-      c = ijk(1) + nc(1) * ((ijk(2) - 1) + nc(2) * (ijk(3) - 1))
-      cnt(c) = cnt(c) + 1.0_wp
-    end do
-    call model%comm%sum(cnt)
-    counts = nint(cnt)
+    call cell_counts(model, nc, counts)
+    call model%comm%sum_counts(counts)
     before = share(model%boxes)
     static = share(model%boxes0)
     call empm_rcb(nd, nc(1:nd), counts, model%comm%nranks, lo, hi)
     call keep_boxes(model, lo, hi)
     ! Every particle to the process of its box; nothing to do when none changes process.
-    allocate(dest(np))
-    do p = 1, np
-      dest(p) = empm_box_owner(lo, hi, empm_cell_of(model%grid, model%pts%x(:, p))) - 1
-    end do
+    dest = owners(model, lo, hi)
     if (model%comm%sum_int(count(dest /= model%comm%rank)) == 0) return
     m = model%pts%row_size()
     allocate(rows(m, np))
@@ -153,7 +158,7 @@ contains
         do k = b(3, 1, q), b(3, 2, q)
           do j = b(2, 1, q), b(2, 2, q)
             do i = b(1, 1, q), b(1, 2, q)
-              per(q) = per(q) + cnt(i + nc(1) * ((j - 1) + nc(2) * (k - 1)))
+              per(q) = per(q) + counts(i + nc(1) * ((j - 1) + nc(2) * (k - 1)))
             end do
           end do
         end do

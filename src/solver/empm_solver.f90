@@ -252,16 +252,7 @@ contains
       residual0 = model%residual
     end if
     if (e%code == 0) call integ%prepare(model, e)
-    if (e%code == 0) then
-      allocate(psi(model%pts%np), stat=astat, errmsg=amsg)
-      if (astat /= 0) e = empm_alloc_error('energy scratch', 8_int64 * model%pts%np, amsg)
-    end if
-    if (e%code == 0) then
-      ! The stress update's energy densities of a sampled step (model%want_energy).
-      if (allocated(model%diag_psi)) deallocate(model%diag_psi)
-      allocate(model%diag_psi(model%pts%np), stat=astat, errmsg=amsg)
-      if (astat /= 0) e = empm_alloc_error('energy densities', 8_int64 * model%pts%np, amsg)
-    end if
+    if (e%code == 0) call particle_scratch(e)
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
@@ -497,13 +488,31 @@ contains
       call model%pts%copy_state_from(good)
       call integ%resync(model)
       model%residual = res0
-      deallocate(psi, model%diag_psi)
-      allocate(psi(model%pts%np), model%diag_psi(model%pts%np))
-      model%diag_step = -1
-      if (ramping) then
-        deallocate(xprev); allocate(xprev(model%grid%ndim, model%pts%np))
-      end if
+      call particle_scratch(ec)
+      model%diag_step = -1 ! the last stress update's screen was of the particles as they were
     end subroutine rebalance
+
+    ! The time loop's scratch sized by the particles the model holds (at the start, and again
+    ! after a re-cut moved particles between processes).
+    subroutine particle_scratch(ec)
+      type(empm_error_t), intent(inout) :: ec
+      integer :: np
+      np = model%pts%np
+      if (allocated(psi)) deallocate(psi)
+      allocate(psi(np), stat=astat, errmsg=amsg)
+      if (astat /= 0) then
+        ec = empm_alloc_error('energy scratch', 8_int64 * np, amsg); return
+      end if
+      ! The stress update's energy densities of a sampled step (model%want_energy).
+      if (allocated(model%diag_psi)) deallocate(model%diag_psi)
+      allocate(model%diag_psi(np), stat=astat, errmsg=amsg)
+      if (astat /= 0) then
+        ec = empm_alloc_error('energy densities', 8_int64 * np, amsg); return
+      end if
+      if (allocated(xprev)) then
+        deallocate(xprev); allocate(xprev(model%grid%ndim, np))
+      end if
+    end subroutine particle_scratch
 
     ! The potential −Σ m g(t)·x changes with g(t) too: the ramp's work, so that the energy
     ! balance of the summary can subtract it. Diagnostics only (the state is not touched).
