@@ -6,6 +6,7 @@ module empm_nodes
   use empm_strings, only: str
   use empm_grid, only: empm_grid_t
   use empm_extension, only: empm_extension_t
+  use empm_friction, only: empm_friction_t
   implicit none
   private
   public :: empm_nodes_t
@@ -24,6 +25,7 @@ module empm_nodes
     real(wp), allocatable :: vol(:)         !! filled volume Σ N_Ip V_p (nnode) [m^ndim], for
                                             !! the extension of nearly-empty nodes
     type(empm_extension_t) :: ext           !! nearly-empty nodes of the current basis
+    type(empm_friction_t) :: fric           !! frictional walls (`&boundary friction_angle`)
     ! Mirror planes (`&boundary mirror`): ghost node ghost(k) takes msign(d, k) times the value
     ! of its image image(k) across the plane; its mass and numerators are gathered into the
     ! image (docs/free-surfaces.md, "Mirror planes").
@@ -64,6 +66,9 @@ module empm_nodes
     procedure :: constrain_velocity => nodes_constrain_velocity
     procedure :: constrain_force => nodes_constrain_force
     procedure :: compute_reactions => nodes_compute_reactions
+    procedure :: friction_box => nodes_friction_box
+    procedure :: apply_friction => nodes_apply_friction
+    procedure :: restore_friction => nodes_restore_friction
     procedure :: local_damping => nodes_local_damping
     procedure :: find_degenerate => nodes_find_degenerate
     procedure :: mirror_box => nodes_mirror_box
@@ -108,6 +113,7 @@ contains
     call zero(self%force, d * n); call zero(self%acc, d * n); call zero(self%work, d * n)
     call zero(self%vol, n)
     call self%ext%init(n)
+    call self%fric%init(d)
     self%nmirror = 0; self%nplane = 0
     if (allocated(self%ghost)) deallocate(self%ghost, self%image, self%msign, self%plane_side, &
                                           self%plane_at)
@@ -307,6 +313,75 @@ contains
     call self%list_fixed()
     if (present(name)) call add_set(self, name, dofs, comp(1:nd), value(1:nd))
   end subroutine nodes_fix_box
+
+  !> A frictional wall at rest: every node in the box [lo, hi], which must be flat along axis
+  !> |side| (lo = hi there), gets that component fixed at zero and Coulomb friction of
+  !> coefficient `mu` on the others ([[empm_friction]]); the body lies on the `side` of the
+  !> wall (+axis: above it). With `name`, the wall is a reaction set whose reaction includes
+  !> the friction. info: 0 done, 1 the box is not flat along the axis, 2 it selects no node,
+  !> 3 a node is already on another frictional wall.
+  subroutine nodes_friction_box(self, grid, lo, hi, side, mu, nsel, info, name)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields
+    type(empm_grid_t), intent(in) :: grid      !! background grid
+    real(wp), intent(in) :: lo(3)              !! lower corner of the selection box [m]
+    real(wp), intent(in) :: hi(3)              !! upper corner of the selection box [m]
+    integer, intent(in) :: side                !! ±axis: the normal from the wall into the body
+    real(wp), intent(in) :: mu                 !! friction coefficient tan δ (≥ 0)
+    integer, intent(out) :: nsel               !! number of nodes selected
+    integer, intent(out) :: info               !! 0 or the failure above
+    character(len=*), intent(in), optional :: name !! name of the reaction set to record
+    real(wp) :: xi(3), tol
+    logical :: comp(3)
+    integer :: id, a, set
+    a = abs(side); nsel = 0; info = 0
+    if (.not. allocated(self%mass) .or. self%nnode /= grid%nnode) call self%alloc(grid)
+    tol = 1.0e-9_wp * grid%hmin()
+    if (hi(a) - lo(a) > tol) then
+      info = 1; return
+    end if
+    do id = 1, grid%nnode
+      xi = grid%node_coord(id)
+      if (all(xi(1:grid%ndim) >= lo(1:grid%ndim) - tol .and. &
+              xi(1:grid%ndim) <= hi(1:grid%ndim) + tol)) then
+        if (self%fric%has(id)) info = 3
+        nsel = nsel + 1
+      end if
+    end do
+    if (nsel == 0) info = 2
+    if (info /= 0) return
+    comp = .false.; comp(a) = .true.
+    set = 0
+    if (present(name)) then
+      call self%fix_box(grid, lo, hi, comp, [0.0_wp, 0.0_wp, 0.0_wp], nsel, name)
+      set = self%nset
+    else
+      call self%fix_box(grid, lo, hi, comp, [0.0_wp, 0.0_wp, 0.0_wp], nsel)
+    end if
+    do id = 1, grid%nnode
+      xi = grid%node_coord(id)
+      if (all(xi(1:grid%ndim) >= lo(1:grid%ndim) - tol .and. &
+              xi(1:grid%ndim) <= hi(1:grid%ndim) + tol)) &
+        call self%fric%add(id, a, sign(1.0_wp, real(side, wp)), mu, set)
+    end do
+  end subroutine nodes_friction_box
+
+  !> The frictional walls' forces added to the total nodal force `f` (before the fixed dofs
+  !> are zeroed: the normal load is read from it), with the nodal velocities `v` of the step
+  !> and the time `h` over which f/m is added to them; the reaction sets include them.
+  pure subroutine nodes_apply_friction(self, v, h, f)
+    class(empm_nodes_t), intent(inout) :: self     !! nodal fields
+    real(wp), intent(in), contiguous :: v(:,:)     !! nodal velocities (ndim, nnode) [m/s]
+    real(wp), intent(in) :: h                      !! time over which f/m is added to v [s]
+    real(wp), intent(inout), contiguous :: f(:,:)  !! total nodal force (ndim, nnode) [N]
+    call self%fric%apply(self%mass, self%fixed, v, h, f, self%reaction)
+  end subroutine nodes_apply_friction
+
+  !> Put back the walls' tangential forces after a pass that changed every dof (damping).
+  pure subroutine nodes_restore_friction(self, f)
+    class(empm_nodes_t), intent(in) :: self        !! nodal fields
+    real(wp), intent(inout), contiguous :: f(:,:)  !! total nodal force (ndim, nnode) [N]
+    call self%fric%restore(self%fixed, f)
+  end subroutine nodes_restore_friction
 
   !> Append the reaction set `name` (set-up only).
   subroutine add_set(self, name, dofs, comp, value)

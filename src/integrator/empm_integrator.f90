@@ -6,7 +6,8 @@
 module empm_integrator
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
-  use empm_error, only: empm_error_t, empm_raise_error, empm_alloc_error
+  use empm_error, only: empm_error_t, empm_raise, empm_raise_error, empm_alloc_error, &
+                        EMPM_ERR_INPUT
   use empm_family, only: empm_family_t
   use empm_namelist, only: empm_group_t
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_SHAPE_FAILED, &
@@ -75,6 +76,7 @@ module empm_integrator
     procedure :: start => integrator_start
     procedure :: assemble_forces
     procedure :: resync => integrator_resync
+    procedure :: walls => integrator_walls
   end type empm_integrator_t
 
   abstract interface
@@ -107,6 +109,14 @@ contains
     associate (unused_ => self, unused_group_ => group, unused_err_ => err); end associate
   end subroutine integrator_configure
 
+  !> Whether the scheme supports frictional walls (it passes [[assemble_forces]] the time over
+  !> which the force changes the nodal velocities); the default is no.
+  pure logical function integrator_walls(self)
+    class(empm_integrator_t), intent(in) :: self !! integrator
+    associate (unused_ => self); end associate
+    integrator_walls = .false.
+  end function integrator_walls
+
   !> Allocate work arrays for `model` and initialise the scheme's state (`start`). Call once,
   !> after the model's set-up, before stepping ([[empm_solve]] does).
   !> An allocation failure is reported in `err` when present (with the memory asked for),
@@ -117,6 +127,11 @@ contains
     type(empm_error_t), intent(inout), optional :: err  !! set on an allocation failure
     integer :: stat
     character(len=256) :: msg
+    if (model%nodes%fric%n > 0 .and. .not. self%walls()) then
+      call empm_raise(EMPM_ERR_INPUT, 'scheme '''//self%family()//''' does not support '// &
+        'frictional walls (usf, usl, musl, pc_published and pc_newmark do)', err)
+      return
+    end if
     if (allocated(self%bwork)) deallocate(self%bwork)
     allocate(self%bwork(model%grid%ndim, model%pts%np), stat=stat, errmsg=msg)
     if (stat /= 0) then
@@ -383,11 +398,16 @@ contains
   !> fixed dofs zeroed, the residual ‖f_free‖₂/‖f_ext‖₂ (`model%track`; f_ext = m_I g + the
   !> nodal traction forces, the body-force callback left out) and the local damping
   !> f −= α |f| sgn(v) with the nodal velocities `nodes%vel` of the step. Without tractions,
-  !> reaction sets, tracking and damping the work is that of eqs. 16–17 alone.
-  subroutine assemble_forces(self, model, t)
+  !> reaction sets, tracking and damping the work is that of eqs. 16–17 alone. The friction of
+  !> frictional walls ([[empm_friction]]) is added before the fixed dofs are zeroed, from the
+  !> nodal velocities `nodes%vel` and `kick`, the time over which the caller adds f/m to them
+  !> (walls need it: [[integrator_prepare]] refuses them for a scheme that does not pass it);
+  !> the damping leaves the walls' tangential forces as the friction set them.
+  subroutine assemble_forces(self, model, t, kick)
     class(empm_integrator_t), intent(inout) :: self !! integrator (body-force scratch)
     type(empm_model_t), intent(inout) :: model      !! simulation state
     real(wp), intent(in) :: t                       !! time at which loads are evaluated [s]
+    real(wp), intent(in), optional :: kick          !! time over which f/m is added to v_I [s]
     real(wp) :: g(3), fext2, funb
     integer :: np, d
     logical :: use_b
@@ -410,6 +430,8 @@ contains
       model%nodes%force = model%nodes%force + self%tforce
     end if
     if (model%nodes%nset > 0) call model%nodes%compute_reactions(model%nodes%force)
+    if (model%nodes%fric%n > 0 .and. present(kick)) &
+      call model%nodes%apply_friction(model%nodes%vel, kick, model%nodes%force)
     call model%nodes%constrain_force(model%nodes%force)
     if (model%track) then
       if (model%loads%ntraction() > 0) then
@@ -424,8 +446,10 @@ contains
         model%residual = -1.0_wp
       end if
     end if
-    if (self%damping > 0.0_wp) call model%nodes%local_damping(self%damping, model%nodes%vel, &
-                                                               model%nodes%force)
+    if (self%damping > 0.0_wp) then
+      call model%nodes%local_damping(self%damping, model%nodes%vel, model%nodes%force)
+      if (model%nodes%fric%n > 0) call model%nodes%restore_friction(model%nodes%force)
+    end if
   end subroutine assemble_forces
 
   !> Σ_I |m_I g + t_I|², the squared norm of the nodal external force (gravity and tractions).

@@ -30,6 +30,7 @@ module empm_integrator_euler
     procedure :: step => euler_step
     procedure :: family => euler_family
     procedure :: summary => euler_summary
+    procedure :: walls => euler_walls
   end type empm_euler_t
 
 contains
@@ -56,6 +57,13 @@ contains
     end select
   end function euler_summary
 
+  !> Frictional walls are supported: the nodal force is added over Δt to v_I = p_I/m_I.
+  pure logical function euler_walls(self)
+    class(empm_euler_t), intent(in) :: self !! integrator
+    associate (unused_ => self); end associate
+    euler_walls = .true.
+  end function euler_walls
+
   !> One forward-Euler step.
   subroutine euler_step(self, model, dt, stat)
     class(empm_euler_t), intent(inout) :: self      !! integrator
@@ -72,7 +80,7 @@ contains
         if (stat%code /= STEP_OK) return
       end if
 
-      call self%assemble_forces(model, model%t)
+      call self%assemble_forces(model, model%t, dt)
       call tm%lap(PHASE_P2G)
       ! p^{k+1} = p^k + Δt f, then the constraints on the new nodal velocity.
       nodes%mom = nodes%mom + dt * nodes%force

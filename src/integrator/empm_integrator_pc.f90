@@ -42,6 +42,7 @@ module empm_integrator_pc
     procedure :: params => pc_params
     procedure :: configure => pc_configure
     procedure :: start => pc_start
+    procedure :: walls => pc_walls
   end type empm_pc_t
 
 contains
@@ -95,6 +96,16 @@ contains
     call initial_acceleration(self, model)
   end subroutine pc_start
 
+  !> Frictional walls are supported. The force of t + Δt acts on the velocity twice: γΔt in
+  !> this step's corrector (kick), (1 − γ)Δt in the next step's predictor; the friction is sized
+  !> over the whole Δt, so that a sticking node's predicted velocity v*_I, the one that moves
+  !> and strains the particles, is zero (sized over γΔt, the next predictor would reverse it).
+  pure logical function pc_walls(self)
+    class(empm_pc_t), intent(in) :: self !! integrator
+    associate (unused_ => self); end associate
+    pc_walls = .true.
+  end function pc_walls
+
   !> One predictor-corrector step.
   subroutine pc_step(self, model, dt, stat)
     class(empm_pc_t), intent(inout) :: self         !! integrator
@@ -114,7 +125,7 @@ contains
         if (stat%code /= STEP_OK) return
         ! Balance of forces at t + Δt with the basis of x^n, as published; nodes%acc = f/m
         ! (zero on fixed dofs).
-        call self%assemble_forces(model, model%t + dt)
+        call self%assemble_forces(model, model%t + dt, dt)
         call tm%lap(PHASE_P2G)
         call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
         call tm%lap(PHASE_GRID)
@@ -136,7 +147,7 @@ contains
         call drift_end(self, model, dt, stat)
         if (stat%code /= STEP_OK) return
         ! Kick: a^{n+1} = f(σ^{n+1}, t + Δt)/m on the grid the particles now see.
-        call self%assemble_forces(model, model%t + dt)
+        call self%assemble_forces(model, model%t + dt, dt)
         call tm%lap(PHASE_P2G)
         call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
         call tm%lap(PHASE_GRID)

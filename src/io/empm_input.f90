@@ -156,7 +156,14 @@ contains
           'axis (a grid line), its nodes get the fix components fixed at zero, and the nodes '// &
           'on the given side of it are ghosts with the mirrored values (fix components odd, '// &
           'the others even): a fixed end with symmetric supports (docs/free-surfaces.md)', &
-          default='''none''', choices='none -x +x -y +y -z +z')]
+          default='''none''', choices='none -x +x -y +y -z +z'), &
+        empm_param('friction_angle', PARAM_REAL, 'deg', 'a frictional wall at rest: the '// &
+          'box is flat along the axis of normal, its nodes get the normal component fixed at '// &
+          'zero and Coulomb friction tan(friction_angle) on the others (replaces fix; '// &
+          'docs/input.md)', lo=0.0_wp, hi=90.0_wp, hi_open=.true., optional=.true.), &
+        empm_param('normal', PARAM_STR, '-', 'with friction_angle: the direction from the '// &
+          'wall into the body (''+y'' for a base under it)', optional=.true., &
+          choices='-x +x -y +y -z +z')]
     case ('traction')
       p = [ &
         empm_param('name', PARAM_STR, '-', 'label (messages)', optional=.true.), &
@@ -879,6 +886,11 @@ contains
         call g%fail(e, merge('lo', 'hi', nlo < nd), 'required: the box selecting the nodes, '// &
           str(nd)//' coordinates each of lo and hi [m] (boundary '//str(nb)//')'); return
       end if
+      if (g%has('friction_angle') .or. g%has('normal')) then
+        call read_wall(g, p, cs, lo, hi, name, nb, e)
+        if (e%code /= EMPM_OK) return
+        cycle
+      end if
       if (.not. any(fix(1:nd))) then
         call g%fail(e, 'fix', 'expected at least one .true. component (boundary '//str(nb)//')')
         return
@@ -899,6 +911,64 @@ contains
       end if
     end do
   end subroutine read_boundaries
+
+  ! A frictional wall (`friction_angle`, `normal`): checks, then the wall's nodes.
+  subroutine read_wall(g, p, cs, lo, hi, name, nb, e)
+    type(empm_group_t), intent(inout) :: g
+    type(empm_param_t), intent(in) :: p(:)
+    type(empm_case_t), intent(inout) :: cs
+    real(wp), intent(in) :: lo(3), hi(3)
+    character(len=*), intent(in) :: name
+    integer, intent(in) :: nb
+    type(empm_error_t), intent(inout) :: e
+    real(wp), parameter :: DEG = acos(-1.0_wp) / 180.0_wp
+    character(len=:), allocatable :: normal
+    character(len=*), parameter :: KEYS(3) = [character(len=8) :: 'fix', 'velocity', 'mirror']
+    real(wp) :: delta
+    integer :: a, side, k, nsel, info
+    if (.not. g%has('friction_angle') .or. .not. g%has('normal')) then
+      call g%fail(e, merge('normal        ', 'friction_angle', g%has('friction_angle')), &
+        'a frictional wall needs both friction_angle and normal (boundary '//str(nb)//')')
+      return
+    end if
+    do k = 1, size(KEYS)
+      if (g%has(trim(KEYS(k)))) then
+        call g%fail(e, trim(KEYS(k)), 'not with friction_angle: a frictional wall is at '// &
+          'rest and fixes its normal component itself (boundary '//str(nb)//')'); return
+      end if
+    end do
+    delta = 0.0_wp; normal = ''
+    call g%get(p(7), delta, e)
+    call g%get(p(8), normal, e)
+    if (e%code /= EMPM_OK) return
+    a = index('xyz', normal(2:2)); side = merge(-a, a, normal(1:1) == '-')
+    if (a > cs%model%grid%ndim) then
+      call g%fail(e, 'normal', 'axis '''//normal(2:2)//''' beyond ndim = '// &
+        str(cs%model%grid%ndim)//' (boundary '//str(nb)//')'); return
+    end if
+    if (.not. cs%integ%walls()) then
+      call g%fail(e, 'friction_angle', 'scheme '''//cs%integ%family()//''' does not '// &
+        'support frictional walls (usf, usl, musl, pc_published and pc_newmark do) '// &
+        '(boundary '//str(nb)//')'); return
+    end if
+    if (g%has('name')) then
+      call cs%model%nodes%friction_box(cs%model%grid, lo, hi, side, tan(delta * DEG), nsel, &
+                                       info, name)
+    else
+      call cs%model%nodes%friction_box(cs%model%grid, lo, hi, side, tan(delta * DEG), nsel, info)
+    end if
+    select case (info)
+    case (1)
+      call g%fail(e, 'lo', 'a frictional wall''s box must be flat along '//normal(2:2)// &
+        ' (lo = hi there) (boundary '//str(nb)//')'); return
+    case (2)
+      call g%fail(e, 'lo', 'the box [lo, hi] selects no grid node (boundary '//str(nb)// &
+        '): nodes lie at origin + i*h'); return
+    case (3)
+      call g%fail(e, 'lo', 'a node of this wall is on another frictional wall (boundary '// &
+        str(nb)//')'); return
+    end select
+  end subroutine read_wall
 
   ! A mirror-plane boundary (`mirror = '-x'` ...): checks, the plane and its ghosts, and no
   ! particle on the ghost side.

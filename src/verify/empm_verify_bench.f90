@@ -22,7 +22,8 @@ module empm_verify_bench
   public :: empm_bench_t, bench_known
 
   character(len=*), parameter :: KNOWN = 'dyka vibrating_bar andersen mms_linear_1d '// &
-    'mms_linear_2d mms_neohookean_1d mms_axis_aligned_2d colliding_disks footing'
+    'mms_linear_2d mms_neohookean_1d mms_axis_aligned_2d colliding_disks footing '// &
+    'column_collapse'
 
   ! Prandtl strip footing (docs/benchmarks.md): undrained cohesion, footing half-width of the
   ! half model, and the material's P-wave speed (E = 5 MPa, nu = 0.3, rho = 2000 kg/m3).
@@ -39,6 +40,9 @@ module empm_verify_bench
     type(empm_char_bar_t) :: dyka               !! Dyka bar by characteristics
     type(empm_vibrating_bar_t) :: bar           !! vibrating bar
     type(empm_column_t) :: column               !! self-weight column (Andersen block)
+    real(wp) :: box(2, 2) = 0.0_wp              !! column_collapse: the initial column
+                                                !! [x_lo, y_lo; x_hi, y_hi] [m]
+    real(wp) :: bin = 0.0_wp                    !! column_collapse: profile bin width [m]
     class(empm_mms_t), allocatable :: mms       !! manufactured solution (mms_* benchmarks)
   contains
     procedure :: prepare => bench_prepare
@@ -59,7 +63,8 @@ contains
   !> True when the benchmark has a pointwise exact solution.
   elemental logical function bench_has_exact(self)
     class(empm_bench_t), intent(in) :: self !! benchmark
-    bench_has_exact = self%id /= 'colliding_disks' .and. self%id /= 'footing'
+    bench_has_exact = self%id /= 'colliding_disks' .and. self%id /= 'footing' .and. &
+                      self%id /= 'column_collapse'
   end function bench_has_exact
 
   !> Exact displacement, velocity and Cauchy stress (Voigt) at reference position `X`, time `t`.
@@ -162,6 +167,8 @@ contains
       ! Prandtl: q = (2 + pi) c for a rigid rough strip on weightless Tresca soil.
       call expect_speed(FOOT_CP)
       self%sscale = (2.0_wp + pi) * FOOT_C; self%uscale = 2.0_wp * FOOT_HALF
+    case ('column_collapse')
+      call column_box()
     case default
       emsg = 'unknown benchmark '''//trim(id)//'''; known: '//KNOWN
     end select
@@ -171,6 +178,28 @@ contains
     end if
 
   contains
+
+    ! Granular column collapse (docs/benchmarks.md): a 2D column of whole cells under gravity
+    ! along -y; its box from the particles' reference positions, checked by its volume.
+    subroutine column_box()
+      real(wp) :: h(2), g(3)
+      if (cs%model%grid%ndim /= 2) then
+        emsg = cs%file//': column_collapse is a 2D (plane-strain) benchmark'; return
+      end if
+      g = cs%model%loads%gravity_at(huge(1.0_wp))
+      if (.not. (g(2) < 0.0_wp .and. g(1) == 0.0_wp)) then
+        emsg = cs%file//': column_collapse needs gravity along -y'; return
+      end if
+      h = cs%model%grid%h(1:2)
+      self%box(:, 1) = h * floor(minval(cs%model%pts%x0(:, 1:np), dim=2) / h + 1.0e-9_wp)
+      self%box(:, 2) = h * ceiling(maxval(cs%model%pts%x0(:, 1:np), dim=2) / h - 1.0e-9_wp)
+      if (abs(sum(cs%model%pts%vol0(1:np)) - product(self%box(:, 2) - self%box(:, 1))) > &
+          1.0e-9_wp * product(self%box(:, 2) - self%box(:, 1))) then
+        emsg = cs%file//': column_collapse needs one rectangular column of whole cells'; return
+      end if
+      self%bin = 0.5_wp * h(1)
+      self%uscale = self%box(1, 2) - self%box(1, 1)
+    end subroutine column_box
 
     subroutine expect_speed(c)
       real(wp), intent(in) :: c
@@ -294,12 +323,57 @@ contains
           value = value / self%sscale
           if (trim(name) == 'limit_pressure_error') value = abs(value - 1.0_wp)
         end if
+      case ('runout', 'runout_error_linear', 'runout_error_power', 'final_height', &
+            'kinetic_end')
+        if (trim(self%id) /= 'column_collapse') then
+          emsg = trim(name)//' is defined for the column_collapse benchmark only'; return
+        end if
+        call collapse(trim(name), value)
       case default
         emsg = 'unknown metric '''//trim(name)//''''
       end select
     end associate
 
   contains
+
+    ! Column collapse (docs/benchmarks.md). The deposit's profile: the particles' reference
+    ! volumes (mass over initial density, so that a loose front does not count as height)
+    ! per bin of half a cell from the back wall, over the bin width. The deposit ends at the
+    ! first bin from the wall thinner than 1 % of H0, a gap (one particle alone gives 2.5 % of
+    ! H0 at 2 x 2 particles per cell and H0 = 20 cells): stray particles beyond it are not the
+    ! deposit. runout = (L_f - L0)/L0; the errors are against Lube et al.'s (2005) fits 1.2 a
+    ! and 1.9 a^(2/3); final_height = the profile's highest bin / H0; kinetic_end = the last
+    ! kinetic energy over the largest (at rest: the elastic ringing only).
+    subroutine collapse(metric, v)
+      character(len=*), intent(in) :: metric
+      real(wp), intent(out) :: v
+      real(wp), allocatable :: hgt(:)
+      real(wp) :: l0, h0, a
+      integer :: nb, p, i
+      l0 = self%box(1, 2) - self%box(1, 1); h0 = self%box(2, 2) - self%box(2, 1)
+      a = h0 / l0
+      if (metric == 'kinetic_end') then
+        v = hist%kinetic(hist%nt) / maxval(hist%kinetic(1:hist%nt)); return
+      end if
+      nb = int((maxval(cs%model%pts%x(1, 1:np)) - self%box(1, 1)) / self%bin) + 2
+      allocate(hgt(nb)); hgt = 0.0_wp
+      do p = 1, np
+        i = max(1, int((cs%model%pts%x(1, p) - self%box(1, 1)) / self%bin) + 1)
+        hgt(i) = hgt(i) + cs%model%pts%vol0(p) / self%bin
+      end do
+      if (metric == 'final_height') then
+        v = maxval(hgt) / h0; return
+      end if
+      i = 1
+      do while (i < nb .and. hgt(i) >= 0.01_wp * h0)
+        i = i + 1
+      end do
+      v = ((i - 1) * self%bin - l0) / l0
+      select case (metric)
+      case ('runout_error_linear'); v = abs(v / (1.2_wp * a) - 1.0_wp)
+      case ('runout_error_power'); v = abs(v / (1.9_wp * a**(2.0_wp / 3.0_wp)) - 1.0_wp)
+      end select
+    end subroutine collapse
 
     ! Footing: the limit pressure is the mean of p = -R_y/b over the samples of the last
     ! quarter of the penetration (delta >= 3/4 of the final one), where the curve has
