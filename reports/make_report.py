@@ -494,7 +494,7 @@ def collapse_section(s):
     return ["## Granular column collapse", "",
             "Final deposit profiles (the particles' reference volumes per half cell, over the "
             "bin width; docs/benchmarks.md) against the runout of Lube et al.'s (2005) fits. The "
-            "runout is not converged in h at a = 2 (the h = 5 mm and 1 cm runs differ by a "
+            "runout grows with refinement (at a = 2 the h = 5 mm and 1 cm runs differ by a "
             "one-particle sheet).", "",
             f"![column collapse]({savefig(fig, 'column_collapse.png')})", "", *rows, ""]
 
