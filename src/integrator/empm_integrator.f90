@@ -25,7 +25,7 @@ module empm_integrator
   implicit none
   private
   public :: empm_integrator_t, eval_basis, map_velocity, update_stress, initial_acceleration
-  public :: particle_axpy, drift_prepare, drift_begin, drift_end
+  public :: particle_axpy, drift_prepare, drift_begin, drift_end, WALL_SCHEMES
 
   !> Particles per material call in [[update_stress]]: their L, F, strain and stress fit in
   !> the L1 cache together.
@@ -34,6 +34,8 @@ module empm_integrator
   !> (the run-time guards' and the energy history's share of the stress pass): a multiple of
   !> STRESS_BLOCK, small enough for the group's stress, strain and state to stay in cache.
   integer, parameter :: SCREEN_GROUP = 256
+  !> The schemes whose `walls` is true (messages).
+  character(len=*), parameter :: WALL_SCHEMES = 'usf, usl, musl, pc_published and pc_newmark'
 
   !> Abstract explicit integrator. Work arrays are allocated once in `prepare`. A scheme names
   !> itself (`family`, the registry name, also returned by `name`), may declare parameters
@@ -129,7 +131,7 @@ contains
     character(len=256) :: msg
     if (model%nodes%fric%n > 0 .and. .not. self%walls()) then
       call empm_raise(EMPM_ERR_INPUT, 'scheme '''//self%family()//''' does not support '// &
-        'frictional walls (usf, usl, musl, pc_published and pc_newmark do)', err)
+        'frictional walls ('//WALL_SCHEMES//' do)', err)
       return
     end if
     if (allocated(self%bwork)) deallocate(self%bwork)

@@ -20,6 +20,7 @@ module empm_input
                          PARAM_REAL, PARAM_INT, PARAM_STR, PARAM_LOGICAL
   use empm_namelist, only: empm_group_t, empm_parse_namelist
   use empm_case, only: empm_case_t, empm_overrides_t
+  use empm_integrator, only: WALL_SCHEMES
   use empm_model, only: empm_material_slot_t
   use empm_loads, only: RAMP_NONE, RAMP_SINE, RAMP_LINEAR, empm_traction_t, empm_geostatic_stress
   use empm_extension, only: EXT_THETA_DEFAULT
@@ -927,7 +928,7 @@ contains
     real(wp) :: delta
     integer :: a, side, k, nsel, info
     if (.not. g%has('friction_angle') .or. .not. g%has('normal')) then
-      call g%fail(e, merge('normal        ', 'friction_angle', g%has('friction_angle')), &
+      call g%fail(e, trim(merge('normal        ', 'friction_angle', g%has('friction_angle'))), &
         'a frictional wall needs both friction_angle and normal (boundary '//str(nb)//')')
       return
     end if
@@ -948,8 +949,7 @@ contains
     end if
     if (.not. cs%integ%walls()) then
       call g%fail(e, 'friction_angle', 'scheme '''//cs%integ%family()//''' does not '// &
-        'support frictional walls (usf, usl, musl, pc_published and pc_newmark do) '// &
-        '(boundary '//str(nb)//')'); return
+        'support frictional walls ('//WALL_SCHEMES//' do) (boundary '//str(nb)//')'); return
     end if
     if (g%has('name')) then
       call cs%model%nodes%friction_box(cs%model%grid, lo, hi, side, tan(delta * DEG), nsel, &
