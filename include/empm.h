@@ -55,7 +55,7 @@ int empm_model_from_case(const char *path, empm_model **out, char *errbuf, size_
 
 /* An empty model on a grid of ncell[i] cells of size h[i] from origin (ndim entries each).
  * Then: set_shape, set_integrator (defaults "linear" and "musl"), add_material, add_particles,
- * fix_box, set_time_step, and finalize. */
+ * fix_box, set_gravity, friction_box, set_time_step, and finalize. */
 int empm_model_create(int ndim, const double *origin, const double *h, const int *ncell,
                       empm_model **out, char *errbuf, size_t errlen);
 
@@ -73,6 +73,14 @@ int empm_model_add_particles(empm_model *m, int n, const double *x, const double
  * each; *nsel receives the number of nodes selected. */
 int empm_model_fix_box(empm_model *m, const double lo[3], const double hi[3], const int mask[3],
                        const double value[3], int *nsel);
+/* Constant gravity g[3] [m/s^2] (the first ndim entries are used). */
+int empm_model_set_gravity(empm_model *m, const double g[3]);
+/* A frictional wall at rest on the nodes in the box [lo, hi], flat along the normal's axis:
+ * normal component fixed at zero, Coulomb friction tan(friction_angle) [deg] on the others;
+ * normal = +axis or -axis (1..ndim), the direction from the wall into the body (+2: a base
+ * under the body in 2D). Schemes usf, usl, musl, pc_published, pc_newmark. */
+int empm_model_friction_box(empm_model *m, const double lo[3], const double hi[3], int normal,
+                            double friction_angle, int *nsel);
 /* Time step: dt = cfl * stable step when dt == 0 (default cfl 0.5), else the fixed dt. */
 int empm_model_set_time_step(empm_model *m, double cfl, double dt);
 /* Finish the set-up; the model can then step (case-file models are finalized already). */

@@ -15,11 +15,12 @@
 module empm_capi
   use, intrinsic :: iso_c_binding, only: c_int, c_double, c_char, c_ptr, c_null_ptr, c_null_char, &
                                          c_associated, c_f_pointer, c_loc, c_size_t
-  use empm_kinds, only: wp
+  use empm_kinds, only: wp, pi
   use empm_version_info, only: empm_version
+  use empm_strings, only: str
   use empm_error, only: empm_error_t, EMPM_OK, EMPM_ERR_USAGE, EMPM_ERR_INPUT, EMPM_ERR_IO
   use empm_model, only: empm_model_t, empm_material_slot_t
-  use empm_integrator, only: empm_integrator_t
+  use empm_integrator, only: empm_integrator_t, WALL_SCHEMES
   use empm_material, only: STATE_NAME_LEN
   use empm_registry, only: empm_create_shape, empm_create_material, empm_create_integrator
   use empm_history, only: empm_history_t
@@ -33,6 +34,7 @@ module empm_capi
   public :: empm_capi_box_t
   public :: capi_from_case, capi_create, capi_set_shape, capi_set_integrator, capi_add_material
   public :: capi_add_particles, capi_fix_box, capi_set_time_step, capi_finalize, capi_step
+  public :: capi_set_gravity, capi_friction_box
   public :: capi_advance_to, capi_field_size, capi_get_field, capi_set_field, capi_write
   public :: capi_destroy, capi_box, capi_run_case, capi_energies, capi_probe
   public :: capi_copy_message
@@ -342,6 +344,58 @@ contains
     b%message = ''
   end function capi_fix_box
 
+  !> Gravity (constant, from t = 0) [m/s²]; its first ndim components are used.
+  integer function capi_set_gravity(b, g) result(rc)
+    type(empm_capi_box_t), pointer, intent(in) :: b !! box
+    real(wp), intent(in) :: g(3)                    !! gravity vector [m/s²]
+    rc = check_open(b, 'empm_model_set_gravity', .true.)
+    if (rc /= EMPM_OK) return
+    if (.not. all(abs(g) <= huge(1.0_wp))) then
+      rc = fail(b, EMPM_ERR_USAGE, 'empm_model_set_gravity: g must be finite'); return
+    end if
+    b%model%loads%gravity = 0.0_wp
+    b%model%loads%gravity(1:b%model%grid%ndim) = g(1:b%model%grid%ndim)
+    b%message = ''
+  end function capi_set_gravity
+
+  !> A frictional wall at rest on the nodes inside the box [lo, hi] (flat along the normal's
+  !> axis): normal component fixed at zero, Coulomb friction tan δ on the others
+  !> (docs/input.md, `&boundary friction_angle`). `normal` = ±axis (1..ndim), the direction from
+  !> the wall into the body.
+  integer function capi_friction_box(b, lo, hi, normal, delta, nsel) result(rc)
+    type(empm_capi_box_t), pointer, intent(in) :: b !! box
+    real(wp), intent(in) :: lo(3)                   !! lower corner [m]
+    real(wp), intent(in) :: hi(3)                   !! upper corner [m]
+    integer, intent(in) :: normal                   !! ±axis from the wall into the body
+    real(wp), intent(in) :: delta                   !! friction angle [deg], in [0, 90)
+    integer, intent(out) :: nsel                    !! nodes selected
+    character(len=*), parameter :: WHAT = 'empm_model_friction_box: '
+    integer :: info
+    nsel = 0
+    rc = check_open(b, 'empm_model_friction_box', .true.)
+    if (rc /= EMPM_OK) return
+    if (normal == 0 .or. abs(normal) > b%model%grid%ndim) then
+      rc = fail(b, EMPM_ERR_USAGE, WHAT//'normal must be +-1..+-'//str(b%model%grid%ndim)// &
+        ' (the axis from the wall into the body), got '//str(normal)); return
+    end if
+    if (.not. (delta >= 0.0_wp .and. delta < 90.0_wp)) then
+      rc = fail(b, EMPM_ERR_USAGE, WHAT//'the friction angle must be in [0, 90) degrees, got '// &
+        str(delta)); return
+    end if
+    call b%model%nodes%friction_box(b%model%grid, lo, hi, normal, tan(delta * pi / 180.0_wp), &
+                                    nsel, info)
+    select case (info)
+    case (1)
+      rc = fail(b, EMPM_ERR_USAGE, WHAT//'the box must be flat along the normal''s axis')
+    case (2)
+      rc = fail(b, EMPM_ERR_USAGE, WHAT//'the box selects no grid node')
+    case (3)
+      rc = fail(b, EMPM_ERR_USAGE, WHAT//'a node of the box is on another frictional wall')
+    case default
+      b%message = ''
+    end select
+  end function capi_friction_box
+
   !> Time step rule: Δt = cfl·Δt_stable when dt = 0, otherwise the fixed dt (checked against
   !> the stability limit at every step).
   integer function capi_set_time_step(b, cfl, dt) result(rc)
@@ -379,6 +433,10 @@ contains
       if (e%code /= EMPM_OK) then
         rc = remember(b, e); return
       end if
+    end if
+    if (b%model%nodes%fric%n > 0 .and. .not. b%integ%walls()) then
+      rc = fail(b, EMPM_ERR_USAGE, 'empm_model_finalize: integrator '''//b%integ%family()// &
+        ''' does not support frictional walls ('//WALL_SCHEMES//' do)'); return
     end if
     call b%model%finalize_setup(e)
     if (e%code == EMPM_OK) call b%hist%init(b%model%grid%ndim, b%probe_name, b%probe_particle, &
@@ -745,6 +803,27 @@ contains
     rc = capi_fix_box(capi_box(m), lo, hi, int(mask), value, k)
     nsel = int(k, c_int)
   end function c_fix_box
+
+  !> `empm_model_set_gravity`: constant gravity g[3] (the first ndim entries used).
+  integer(c_int) function c_set_gravity(m, g) result(rc) bind(C, name='empm_model_set_gravity')
+    type(c_ptr), value :: m                !! handle
+    real(c_double), intent(in) :: g(3)     !! gravity [m/s²]
+    rc = capi_set_gravity(capi_box(m), g)
+  end function c_set_gravity
+
+  !> `empm_model_friction_box`: a frictional wall at rest on the nodes of a box.
+  integer(c_int) function c_friction_box(m, lo, hi, normal, delta, nsel) result(rc) &
+      bind(C, name='empm_model_friction_box')
+    type(c_ptr), value :: m                !! handle
+    real(c_double), intent(in) :: lo(3)    !! lower corner
+    real(c_double), intent(in) :: hi(3)    !! upper corner
+    integer(c_int), value :: normal        !! ±axis from the wall into the body
+    real(c_double), value :: delta         !! friction angle [deg]
+    integer(c_int), intent(out) :: nsel    !! nodes selected
+    integer :: k
+    rc = capi_friction_box(capi_box(m), lo, hi, int(normal), delta, k)
+    nsel = int(k, c_int)
+  end function c_friction_box
 
   !> `empm_model_set_time_step`: Δt = cfl·Δt_stable (dt = 0) or a fixed dt.
   integer(c_int) function c_set_time_step(m, cfl, dt) result(rc) &

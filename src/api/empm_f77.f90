@@ -18,7 +18,8 @@ module empm_f77
   use empm_capi, only: empm_capi_box_t, capi_box, capi_from_case, capi_create, capi_set_shape, &
                        capi_set_integrator, capi_add_material, capi_add_particles, capi_fix_box, &
                        capi_set_time_step, capi_finalize, capi_step, capi_advance_to, &
-                       capi_get_field, capi_set_field, capi_energies, capi_write, capi_destroy
+                       capi_get_field, capi_set_field, capi_energies, capi_write, capi_destroy, &
+                       capi_set_gravity, capi_friction_box
   use empm_error, only: EMPM_ERR_USAGE
   implicit none
   private
@@ -203,6 +204,30 @@ contains
     ierr = capi_fix_box(capi_box(to_ptr(model)), lo, hi, int(mask), value, k)
     nsel = k
   end subroutine f77_fixbox
+
+  !> `CALL EMPM_GRAVITY(MODEL, G, IERR)`: constant gravity, 3 entries (the first NDIM used).
+  subroutine f77_gravity(model, g, ierr) bind(C, name='empm_gravity_')
+    integer(c_int64_t), intent(in) :: model  !! handle
+    real(c_double), intent(in) :: g(3)       !! gravity [m/s²]
+    integer(c_int), intent(out) :: ierr      !! status
+    ierr = capi_set_gravity(capi_box(to_ptr(model)), g)
+  end subroutine f77_gravity
+
+  !> `CALL EMPM_FRICBOX(MODEL, LO, HI, NORMAL, DELTA, NSEL, IERR)`: a frictional wall at rest
+  !> on the nodes of the box (3 entries each), NORMAL = +-axis from the wall into the body,
+  !> DELTA the friction angle in degrees.
+  subroutine f77_fricbox(model, lo, hi, normal, delta, nsel, ierr) bind(C, name='empm_fricbox_')
+    integer(c_int64_t), intent(in) :: model  !! handle
+    real(c_double), intent(in) :: lo(3)      !! lower corner
+    real(c_double), intent(in) :: hi(3)      !! upper corner
+    integer(c_int), intent(in) :: normal     !! +-axis from the wall into the body
+    real(c_double), intent(in) :: delta      !! friction angle [deg]
+    integer(c_int), intent(out) :: nsel      !! nodes selected
+    integer(c_int), intent(out) :: ierr      !! status
+    integer :: k
+    ierr = capi_friction_box(capi_box(to_ptr(model)), lo, hi, int(normal), delta, k)
+    nsel = k
+  end subroutine f77_fricbox
 
   !> `CALL EMPM_TIMESTEP(MODEL, CFL, DT, IERR)`: DT = 0 for CFL times the stable step.
   subroutine f77_timestep(model, cfl, dt, ierr) bind(C, name='empm_timestep_')

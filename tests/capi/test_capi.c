@@ -96,6 +96,54 @@ int main(int argc, char **argv)
     empm_model_destroy(m);
   }
 
+  /* Gravity and a frictional base through the builder: a block (E = 1 MPa) launched at 1 m/s
+   * slides to rest after v0^2/(2 mu g), mu = tan 10 deg, as in the case-file test
+   * (tests/unit/test_loads.pf); its weight in equilibrium from the start (stress set by the
+   * host: sigma_yy = -rho g (H - y), sigma_xx = 0). Then the wall's bad input. */
+  {
+    const double hc = 0.0625, H = 0.25, mu = tan(10.0 * 3.14159265358979 / 180.0);
+    double origin[2] = {0, 0}, h[2] = {0.0625, 0.0625}, g[3] = {0, -10, 0};
+    double x[2 * 128], vol[128], rho[128], v[2 * 128], s[6 * 128], xe[2 * 128];
+    double lo[3] = {0, 0, 0}, hi[3] = {1, 0, 0}, dx = 0, d = 1.0 / (2 * mu * 10);
+    int ncell[2] = {16, 6}, mat[128], id = 0, p, i, j, nsel = 0;
+    char err[256];
+    empm_model *m = NULL;
+    CHECK(empm_model_create(2, origin, h, ncell, &m, err, sizeof err) == EMPM_OK);
+    CHECK(empm_model_add_material(m, "linear_elastic", "E = 1e6, nu = 0.25, density = 2000",
+                                  &id) == EMPM_OK);
+    for (p = 0, i = 0; i < 16; i++)
+      for (j = 0; j < 8; j++, p++) {
+        x[2 * p] = (i + 0.5) * hc / 2; x[2 * p + 1] = (j + 0.5) * hc / 2;
+        vol[p] = hc * hc / 4; rho[p] = 2000; mat[p] = id;
+        v[2 * p] = 1; v[2 * p + 1] = 0;
+        memset(&s[6 * p], 0, 6 * sizeof(double));
+        s[6 * p + 1] = -2000 * 10 * (H - x[2 * p + 1]);
+      }
+    CHECK(empm_model_add_particles(m, 128, x, vol, rho, mat) == EMPM_OK);
+    CHECK(empm_model_set_gravity(m, g) == EMPM_OK);
+    CHECK(empm_model_friction_box(m, lo, hi, 3, 10.0, &nsel) == EMPM_ERR_USAGE); /* 2D */
+    CHECK(empm_model_error(m, msg, sizeof msg) == EMPM_OK && strstr(msg, "normal") != NULL);
+    CHECK(empm_model_friction_box(m, lo, hi, 2, 90.0, &nsel) == EMPM_ERR_USAGE);
+    hi[1] = hc;
+    CHECK(empm_model_friction_box(m, lo, hi, 2, 10.0, &nsel) == EMPM_ERR_USAGE); /* not flat */
+    CHECK(empm_model_error(m, msg, sizeof msg) == EMPM_OK && strstr(msg, "flat") != NULL);
+    hi[1] = 0;
+    CHECK(empm_model_friction_box(m, lo, hi, 2, 10.0, &nsel) == EMPM_OK && nsel == 17);
+    CHECK(empm_model_set_integrator(m, "gen_alpha_grid", NULL) == EMPM_OK);
+    CHECK(empm_model_finalize(m) == EMPM_ERR_USAGE); /* no frictional walls in gen_alpha */
+    CHECK(empm_model_error(m, msg, sizeof msg) == EMPM_OK && strstr(msg, "frictional") != NULL);
+    CHECK(empm_model_set_integrator(m, "musl", NULL) == EMPM_OK);
+    CHECK(empm_model_finalize(m) == EMPM_OK);
+    CHECK(empm_model_set_field(m, "v", v, 2 * 128) == EMPM_OK);
+    CHECK(empm_model_set_field(m, "stress", s, 6 * 128) == EMPM_OK);
+    CHECK(empm_model_advance_to(m, 0.7) == EMPM_OK);
+    CHECK(empm_model_get_field(m, "x", xe, 2 * 128) == EMPM_OK);
+    for (p = 0; p < 128; p++) dx += (xe[2 * p] - x[2 * p]) / 128;
+    CHECK(fabs(dx - d) < 0.01 * d);
+    printf("block on a frictional base: slid %.5f m (v0^2/(2 mu g) = %.5f m)\n", dx, d);
+    empm_model_destroy(m);
+  }
+
   /* Bad input: a status and a message. */
   CHECK(empm_model_step(null, 1) == EMPM_ERR_USAGE);
   CHECK(empm_model_get_field(null, "x", buf, 20) == EMPM_ERR_USAGE);
