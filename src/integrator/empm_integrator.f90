@@ -821,7 +821,8 @@ contains
               end do
             end do
           end if
-          ctx%first = q0
+          ctx%first = q0; ctx%nid = q1 - q0 + 1
+          ctx%id(1:ctx%nid) = model%pts%id(q0:q1)
           call model%mats(im)%model%update(dt, Lb(:, :, 1:q1 - q0 + 1), model%pts%F(:, :, q0:q1), &
             model%pts%strain(:, q0:q1), model%pts%stress(:, q0:q1), model%pts%state(:, q0:q1), &
             model%pts%rho(q0:q1), ctx, info)

@@ -24,9 +24,10 @@ module empm_material
   use empm_namelist, only: empm_group_t
   implicit none
   private
-  public :: empm_material_t, empm_material_ctx_t, STATE_NAME_LEN
+  public :: empm_material_t, empm_material_ctx_t, STATE_NAME_LEN, CTX_MAX_IDS
 
   integer, parameter :: STATE_NAME_LEN = 32 !! length of the names given by `state_names`
+  integer, parameter :: CTX_MAX_IDS = 64    !! most particle ids a batch context carries
 
   !> Where and when a batch is updated: what a model may need besides the kinematics (a user
   !> subroutine's element number, time and increment number, a regularisation length).
@@ -35,6 +36,9 @@ module empm_material
     integer :: step = 1     !! number of the step being taken (1 for the first)
     integer :: first = 1    !! particle index of the batch's first particle (1-based, in the
                             !! particle arrays)
+    integer :: nid = 0      !! batch size when `id` holds the particles' ids, else 0
+    integer :: id(CTX_MAX_IDS) = 0 !! the batch's particle ids (generation order, the same on
+                            !! any number of processes; a user subroutine's element number)
     integer :: ndim = 3     !! spatial dimension of the model (1, 2 or 3)
     real(wp) :: h = 0.0_wp  !! smallest grid spacing [m] (0 when there is no grid)
   end type empm_material_ctx_t

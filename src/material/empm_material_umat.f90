@@ -11,8 +11,9 @@
 !>    2D plane strain and 1D uniaxial strain: NDI = 3, NSHR = 1 (in 1D the shears stay zero);
 !> 3. calls the UMAT with Δε = Δt sym(L), DFGRD0 = F at the start, DFGRD1 = F advanced with L
 !>    (F₁ = F₀ + Δt L F₀), TIME = t (step time = total time), DTIME = Δt, KSTEP = 1, KINC = the step
-!>    number, NOEL = the particle index, NPT = LAYER = KSPT = 1, CELENT = the smallest grid
-!>    spacing, COORDS = 0 (the material interface carries no positions), TEMP = DTEMP = 0;
+!>    number, NOEL = the particle's id (generation order; the batch index when the caller gives
+!>    no ids), NPT = LAYER = KSPT = 1, CELENT = the smallest grid spacing, COORDS = 0 (the
+!>    material interface carries no positions), TEMP = DTEMP = 0;
 !> 4. checks the result: a non-finite STRESS, a write past STATEV(NSTATV) (guard values after
 !>    the state variables) or PNEWDT < 1 even at the smallest sub-increment fail the particle;
 !>    PNEWDT < 1 otherwise discards the attempt (it ran on copies) and retries the step in k
@@ -505,7 +506,11 @@ contains
       a%time = t
       a%dtime = dt
       a%pnewdt = 1.0e36_wp ! "no limit": a UMAT lowers it to ask for a smaller increment
-      a%noel = int(first + p - 1, c_int)
+      if (p <= ctx%nid) then
+        a%noel = int(ctx%id(p), c_int)
+      else
+        a%noel = int(first + p - 1, c_int)
+      end if
       associate (r => a%at)
         call umat_at(r(1), r(2), r(3), r(4), r(5), r(6), r(7), r(8), r(9), r(10), r(11), r(12), &
           r(13), r(14), r(15), r(16), r(17), r(18), r(19), r(20), r(21), r(22), r(23), r(24), &

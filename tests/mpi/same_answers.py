@@ -131,22 +131,51 @@ CASES = {
   history_every = 20, snapshot_times = {snap}
 /
 """,
+    # 2D: a block of a user material (tests/umat/umat_probe.f, which records its arguments in
+    # STATEV: NOEL must be the particle's id, the same on any number of processes). The probe
+    # keeps the stress at zero: the block moves with its initial (non-uniform) velocity, so the
+    # strains it is handed are not round-off.
+    "umat2d": """&grid
+  ndim = 2, h = 0.0625, cells = 16, 6
+/
+&material
+  name = 'm', model = 'umat', library = '{umat_lib}', nstatv = 46, props = 7.5,
+  E = 1.0e6, nu = 0.25, density = 2000.0
+/
+&particles
+  material = 'm', lo = 0.0, 0.0, hi = 0.5, 0.25, velocity = 0.2, 0.0,
+  velocity_sine_amplitude = 0.1, 0.05, velocity_sine_wavenumber = 6.0, 4.0
+/
+&shape
+  family = '{shape}' {shape_keys}
+/
+&integrator
+  scheme = '{scheme}', t_end = {t_end}
+/
+&output
+  history_every = 20, snapshot_times = {snap}
+/
+""",
 }
 
 # Per case: end time and snapshot times (the disks meet at t = 1.6 s and part again; the
 # block stops at 0.57 s).
 TIMES = {"bar1d": (4.0, "1.0, 2.0, 4.0"), "disks2d": (3.0, "1.0, 2.0, 3.0"),
-         "block3d": (0.1, "0.05, 0.1"), "slide2d": (0.7, "0.3, 0.7")}
+         "block3d": (0.1, "0.05, 0.1"), "slide2d": (0.7, "0.3, 0.7"),
+         "umat2d": (0.05, "0.02, 0.05")}
 SCHEMES = ["musl", "usl", "usf", "pc_newmark", "pc_published", "gen_alpha", "gen_alpha_grid"]
 # Frictional walls: not gen_alpha* (refused); usl inverts the block's front particle (docs/input.md).
 SLIDE_SCHEMES = ["musl", "usf", "pc_newmark", "pc_published"]
 SHAPES = {"linear": "", "ugimp": "", "bspline2": "", "lme": ", gamma = 1.8"}
 
 
+UMAT_LIB = ""  # set in main: the probe UMAT built beside empm (tests/umat)
+
+
 def case_text(name, scheme, shape):
     t_end, snap = TIMES[name]
     return CASES[name].format(scheme=scheme, shape=shape, shape_keys=SHAPES[shape],
-                              t_end=t_end, snap=snap)
+                              t_end=t_end, snap=snap, umat_lib=UMAT_LIB)
 
 
 def scales(f):
@@ -204,8 +233,15 @@ def main():
     work.mkdir(parents=True, exist_ok=True)
     mpi = [mpirun, "--oversubscribe"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
     env_note = []
+    global UMAT_LIB
+    lib = pathlib.Path(empm).resolve().parent / "tests" / "umat" / "libumat_probe.so"
+    UMAT_LIB = str(lib)
     combos = [c for c in itertools.product(CASES, SCHEMES, SHAPES)
               if c[0] != "slide2d" or (c[2] == "linear" and c[1] in SLIDE_SCHEMES)]
+    combos = [c for c in combos if c[0] != "umat2d" or (c[1] == "musl" and c[2] == "linear")]
+    if not lib.exists():
+        combos = [c for c in combos if c[0] != "umat2d"]
+        env_note.append(f"umat2d skipped: no {lib}")
     if quick:
         combos = [c for c in combos if c[2] == "linear" or c[1] == "pc_newmark"]
     failures = 0
