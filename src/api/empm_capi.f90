@@ -18,6 +18,7 @@ module empm_capi
   use empm_kinds, only: wp, pi
   use empm_version_info, only: empm_version
   use empm_strings, only: str
+  use empm_friction, only: empm_wall_problem
   use empm_error, only: empm_error_t, EMPM_OK, EMPM_ERR_USAGE, EMPM_ERR_INPUT, EMPM_ERR_IO
   use empm_model, only: empm_model_t, empm_material_slot_t
   use empm_integrator, only: empm_integrator_t, WALL_SCHEMES
@@ -384,16 +385,11 @@ contains
     end if
     call b%model%nodes%friction_box(b%model%grid, lo, hi, normal, tan(delta * pi / 180.0_wp), &
                                     nsel, info)
-    select case (info)
-    case (1)
-      rc = fail(b, EMPM_ERR_USAGE, WHAT//'the box must be flat along the normal''s axis')
-    case (2)
-      rc = fail(b, EMPM_ERR_USAGE, WHAT//'the box selects no grid node')
-    case (3)
-      rc = fail(b, EMPM_ERR_USAGE, WHAT//'a node of the box is on another frictional wall')
-    case default
+    if (info /= 0) then
+      rc = fail(b, EMPM_ERR_USAGE, WHAT//empm_wall_problem(info, abs(normal)))
+    else
       b%message = ''
-    end select
+    end if
   end function capi_friction_box
 
   !> Time step rule: Δt = cfl·Δt_stable when dt = 0, otherwise the fixed dt (checked against

@@ -16,7 +16,7 @@ module empm_friction
   use empm_kinds, only: wp
   implicit none
   private
-  public :: empm_friction_t
+  public :: empm_friction_t, empm_wall_problem
 
   !> The frictional wall nodes of a model (few: a boundary's worth).
   type :: empm_friction_t
@@ -47,21 +47,37 @@ contains
     allocate(self%node(0), self%axis(0), self%sgn(0), self%mu(0), self%set(0), self%kept(ndim, 0))
   end subroutine friction_init
 
-  !> Append wall node `id` (set-up only).
-  subroutine friction_add(self, id, axis, sgn, mu, set)
+  !> Append the nodes `ids` of one wall (set-up only).
+  subroutine friction_add(self, ids, axis, sgn, mu, set)
     class(empm_friction_t), intent(inout) :: self !! walls
-    integer, intent(in) :: id                     !! node id
+    integer, intent(in) :: ids(:)                 !! node ids
     integer, intent(in) :: axis                   !! normal axis
     real(wp), intent(in) :: sgn                   !! +1: the body on the +axis side; −1: on −
     real(wp), intent(in) :: mu                    !! friction coefficient (≥ 0)
     integer, intent(in) :: set                    !! reaction set, 0 for none
     real(wp), allocatable :: k(:,:)
-    self%n = self%n + 1
-    self%node = [self%node, id]; self%axis = [self%axis, axis]; self%sgn = [self%sgn, sgn]
-    self%mu = [self%mu, mu]; self%set = [self%set, set]
+    integer :: m
+    m = size(ids)
+    self%node = [self%node, ids]; self%axis = [self%axis, spread(axis, 1, m)]
+    self%sgn = [self%sgn, spread(sgn, 1, m)]; self%mu = [self%mu, spread(mu, 1, m)]
+    self%set = [self%set, spread(set, 1, m)]
+    self%n = self%n + m
     allocate(k(size(self%kept, 1), self%n)); k = 0.0_wp
     call move_alloc(k, self%kept)
   end subroutine friction_add
+
+  !> What a wall's set-up status `info` of [[nodes_friction_box]] means ('' for 0).
+  pure function empm_wall_problem(info, axis) result(text)
+    integer, intent(in) :: info           !! 0..3
+    integer, intent(in) :: axis           !! the normal's axis, 1..3
+    character(len=:), allocatable :: text !! the problem
+    select case (info)
+    case (1); text = 'a frictional wall''s box must be flat along '//'xyz'(axis:axis)//' (lo = hi there)'
+    case (2); text = 'the box [lo, hi] selects no grid node (nodes lie at origin + i*h)'
+    case (3); text = 'a node of the box is on another frictional wall'
+    case default; text = ''
+    end select
+  end function empm_wall_problem
 
   !> Whether node `id` is already a wall node.
   pure logical function friction_has(self, id)

@@ -139,7 +139,7 @@ contains
     logical, intent(in) :: comp(3)             !! odd (fixed on the plane) components
     integer, intent(out) :: nsel               !! plane nodes selected
     integer, intent(out) :: info               !! status (above)
-    real(wp) :: xi(3), tol, zero3(3)
+    real(wp) :: tol, zero3(3)
     integer :: a, id, k, ijk(3), g(3), m(3), ip, nd, d, ng
     integer, allocatable :: gh(:), im(:)
     real(wp), allocatable :: sg(:,:)
@@ -156,8 +156,7 @@ contains
     allocate(gh(0), im(0), sg(nd, 0))
     ng = 0
     do id = 1, grid%nnode
-      xi = grid%node_coord(id)
-      if (.not. all(xi(1:nd) >= lo(1:nd) - tol .and. xi(1:nd) <= hi(1:nd) + tol)) cycle
+      if (.not. in_box(grid, id, lo, hi, tol)) cycle
       ijk = grid%node_ijk(id)
       do k = 1, grid%nn(a)
         g = ijk; g(a) = ijk(a) + sign(k, side)
@@ -288,7 +287,7 @@ contains
     real(wp), intent(in) :: value(3)           !! prescribed velocity components [m/s]
     integer, intent(out) :: nsel               !! number of nodes selected
     character(len=*), intent(in), optional :: name !! name of the reaction set to record
-    real(wp) :: xi(3), tol
+    real(wp) :: tol
     integer :: id, d, nd
     integer, allocatable :: dofs(:)
     if (.not. allocated(self%mass) .or. self%nnode /= grid%nnode) call self%alloc(grid)
@@ -297,9 +296,7 @@ contains
     nsel = 0; nd = grid%ndim
     allocate(dofs(0))
     do id = 1, grid%nnode
-      xi = grid%node_coord(id)
-      if (all(xi(1:grid%ndim) >= lo(1:grid%ndim) - tol .and. &
-              xi(1:grid%ndim) <= hi(1:grid%ndim) + tol)) then
+      if (in_box(grid, id, lo, hi, tol)) then
         nsel = nsel + 1
         do d = 1, grid%ndim
           if (comp(d)) then
@@ -330,24 +327,21 @@ contains
     integer, intent(out) :: nsel               !! number of nodes selected
     integer, intent(out) :: info               !! 0 or the failure above
     character(len=*), intent(in), optional :: name !! name of the reaction set to record
-    real(wp) :: xi(3), tol
+    real(wp) :: tol
     logical :: comp(3)
     integer :: id, a, set
+    integer, allocatable :: ids(:)
     a = abs(side); nsel = 0; info = 0
     if (.not. allocated(self%mass) .or. self%nnode /= grid%nnode) call self%alloc(grid)
     tol = 1.0e-9_wp * grid%hmin()
     if (hi(a) - lo(a) > tol) then
       info = 1; return
     end if
-    do id = 1, grid%nnode
-      xi = grid%node_coord(id)
-      if (all(xi(1:grid%ndim) >= lo(1:grid%ndim) - tol .and. &
-              xi(1:grid%ndim) <= hi(1:grid%ndim) + tol)) then
-        if (self%fric%has(id)) info = 3
-        nsel = nsel + 1
-      end if
+    ids = pack([(id, id = 1, grid%nnode)], [(in_box(grid, id, lo, hi, tol), id = 1, grid%nnode)])
+    if (size(ids) == 0) info = 2
+    do id = 1, size(ids)
+      if (self%fric%has(ids(id))) info = 3
     end do
-    if (nsel == 0) info = 2
     if (info /= 0) return
     comp = .false.; comp(a) = .true.
     set = 0
@@ -357,12 +351,7 @@ contains
     else
       call self%fix_box(grid, lo, hi, comp, [0.0_wp, 0.0_wp, 0.0_wp], nsel)
     end if
-    do id = 1, grid%nnode
-      xi = grid%node_coord(id)
-      if (all(xi(1:grid%ndim) >= lo(1:grid%ndim) - tol .and. &
-              xi(1:grid%ndim) <= hi(1:grid%ndim) + tol)) &
-        call self%fric%add(id, a, sign(1.0_wp, real(side, wp)), mu, set)
-    end do
+    call self%fric%add(ids, a, sign(1.0_wp, real(side, wp)), mu, set)
   end subroutine nodes_friction_box
 
   !> The frictional walls' forces added to the total nodal force `f` (before the fixed dofs
@@ -382,6 +371,18 @@ contains
     real(wp), intent(inout), contiguous :: f(:,:)  !! total nodal force (ndim, nnode) [N]
     call self%fric%restore(self%fixed, f)
   end subroutine nodes_restore_friction
+
+  !> Whether node `id` lies in the closed box [lo, hi], within `tol` (the node sets by geometry).
+  pure logical function in_box(grid, id, lo, hi, tol)
+    type(empm_grid_t), intent(in) :: grid !! background grid
+    integer, intent(in) :: id             !! node
+    real(wp), intent(in) :: lo(3), hi(3)  !! the box [m]
+    real(wp), intent(in) :: tol           !! tolerance [m]
+    real(wp) :: xi(3)
+    xi = grid%node_coord(id)
+    in_box = all(xi(1:grid%ndim) >= lo(1:grid%ndim) - tol .and. &
+                 xi(1:grid%ndim) <= hi(1:grid%ndim) + tol)
+  end function in_box
 
   !> Append the reaction set `name` (set-up only).
   subroutine add_set(self, name, dofs, comp, value)

@@ -21,6 +21,7 @@ module empm_input
   use empm_namelist, only: empm_group_t, empm_parse_namelist
   use empm_case, only: empm_case_t, empm_overrides_t
   use empm_integrator, only: WALL_SCHEMES
+  use empm_friction, only: empm_wall_problem
   use empm_model, only: empm_material_slot_t
   use empm_loads, only: RAMP_NONE, RAMP_SINE, RAMP_LINEAR, empm_traction_t, empm_geostatic_stress
   use empm_extension, only: EXT_THETA_DEFAULT
@@ -957,17 +958,7 @@ contains
     else
       call cs%model%nodes%friction_box(cs%model%grid, lo, hi, side, tan(delta * DEG), nsel, info)
     end if
-    select case (info)
-    case (1)
-      call g%fail(e, 'lo', 'a frictional wall''s box must be flat along '//normal(2:2)// &
-        ' (lo = hi there) (boundary '//str(nb)//')'); return
-    case (2)
-      call g%fail(e, 'lo', 'the box [lo, hi] selects no grid node (boundary '//str(nb)// &
-        '): nodes lie at origin + i*h'); return
-    case (3)
-      call g%fail(e, 'lo', 'a node of this wall is on another frictional wall (boundary '// &
-        str(nb)//')'); return
-    end select
+    if (info /= 0) call g%fail(e, 'lo', empm_wall_problem(info, a)//' (boundary '//str(nb)//')')
   end subroutine read_wall
 
   ! A mirror-plane boundary (`mirror = '-x'` ...): checks, the plane and its ghosts, and no
