@@ -50,6 +50,20 @@ void empm_lme_basis(const int *ndim, const int *nnodes, const double *x, const d
  * case's &output file). */
 int empm_run_case_file(const char *path, const char *output, char *errbuf, size_t errlen);
 
+/* MPI (a build with -DEMPM_USE_MPI=ON; otherwise EMPM_ERR_USAGE): the processes of a host's
+ * communicator, passed as its Fortran handle, fcomm = MPI_Comm_c2f(comm) (no mpi.h needed
+ * here). empm works on a private duplicate; MPI stays the host's to start and end.
+ * empm_run_case_file_comm: every process calls with the same arguments; the root writes the
+ * results; every process gets the same status and message (docs/parallel.md). */
+int empm_run_case_file_comm(const char *path, const char *output, int fcomm, char *errbuf,
+                            size_t errlen);
+/* Before finalize: the model runs on the communicator's processes. Every process makes the
+ * same calls and adds every particle; finalize keeps those of its box. Afterwards info, the
+ * fields (get and set) and probe values are this process's particles, in the order they were
+ * added (field "id": that number, from 1); steps, energies and write (the root writes every
+ * particle) are collective: every process calls them. */
+int empm_model_set_comm(empm_model *m, int fcomm);
+
 /* A model from a case file (groups &verify skipped), ready to step. *out is NULL on failure. */
 int empm_model_from_case(const char *path, empm_model **out, char *errbuf, size_t errlen);
 

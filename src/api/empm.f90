@@ -41,6 +41,9 @@ module empm
     empm_run_hook_t, empm_solver_state_t
   use empm_output, only: empm_write_results, empm_output_meta_t
   use empm_driver, only: empm_run_case
+  use empm_comm, only: empm_comm_t, empm_comm_world, empm_comm_serial, empm_comm_from_handle, &
+                       empm_comm_handle_problem, EMPM_MPI_BUILT
+  use empm_partition, only: empm_partition_particles, empm_gather_particles
   implicit none
   private
   ! Kinds, version, errors
@@ -68,5 +71,9 @@ module empm
   public :: empm_history_t, empm_snapshot_t
   public :: empm_run_config_t, empm_solve, empm_stable_dt, empm_energies
   public :: empm_run_hook_t, empm_solver_state_t
+  ! Processes (MPI builds; one process otherwise): docs/parallel.md
+  public :: empm_comm_t, empm_comm_world, empm_comm_serial, empm_comm_from_handle
+  public :: empm_comm_handle_problem, EMPM_MPI_BUILT
+  public :: empm_partition_particles, empm_gather_particles
   public :: empm_write_results, empm_output_meta_t, empm_run_case
 end module empm

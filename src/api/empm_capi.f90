@@ -29,7 +29,9 @@ module empm_capi
   use empm_case, only: empm_case_t
   use empm_input, only: empm_read_case
   use empm_output, only: empm_write_results, empm_output_meta_t
-  use empm_driver, only: empm_run_case
+  use empm_driver, only: empm_run_case, empm_agree_error
+  use empm_comm, only: empm_comm_t, empm_comm_from_handle, empm_comm_handle_problem
+  use empm_partition, only: empm_partition_particles, empm_gather_particles
   implicit none
   private
   public :: empm_capi_box_t
@@ -38,7 +40,7 @@ module empm_capi
   public :: capi_set_gravity, capi_friction_box
   public :: capi_advance_to, capi_field_size, capi_get_field, capi_set_field, capi_write
   public :: capi_destroy, capi_box, capi_run_case, capi_energies, capi_probe
-  public :: capi_copy_message
+  public :: capi_copy_message, capi_run_case_comm, capi_set_comm
 
   integer, parameter :: MSG_LEN = 1024 !! longest stored message (longer ones are cut)
 
@@ -141,6 +143,52 @@ contains
     msg = ''
     if (e%code /= EMPM_OK .and. allocated(e%message)) msg = e%message
   end function capi_run_case
+
+  !> [[capi_run_case]] on the processes of a host's communicator (its Fortran handle): every
+  !> process calls with the same arguments; the root writes the results; every process gets
+  !> the same status and message.
+  integer function capi_run_case_comm(path, output, handle, msg) result(rc)
+    character(len=*), intent(in) :: path                 !! case file
+    character(len=*), intent(in) :: output               !! output override, '' for the case's
+    integer, intent(in) :: handle                        !! the host's communicator
+    character(len=:), allocatable, intent(out) :: msg    !! error text, '' on success
+    type(empm_error_t) :: e
+    type(empm_comm_t) :: comm
+    integer :: info
+    call empm_comm_from_handle(handle, comm, info)
+    if (info /= 0) then
+      rc = EMPM_ERR_USAGE
+      msg = 'empm_run_case_file_comm: '//empm_comm_handle_problem(info)
+      return
+    end if
+    call empm_run_case(path, output=output, progress=.false., err=e, comm=comm)
+    call comm%finish()
+    rc = e%code
+    msg = ''
+    if (e%code /= EMPM_OK .and. allocated(e%message)) msg = e%message
+  end function capi_run_case_comm
+
+  !> Run a programmatic model on the processes of a host's communicator (its Fortran handle;
+  !> before finalize). Every process then makes the same calls: it adds every particle, and
+  !> finalize keeps those of its box ([[empm_partition_particles]]). Fields, `info` and
+  !> `set_field` are then this process's particles (field "id": their numbers in the order they
+  !> were added); steps, energies and `write` (the root writes every particle) are collective.
+  integer function capi_set_comm(b, handle) result(rc)
+    type(empm_capi_box_t), pointer, intent(in) :: b !! box
+    integer, intent(in) :: handle                   !! the host's communicator
+    type(empm_comm_t) :: comm
+    integer :: info
+    rc = check_open(b, 'empm_model_set_comm', .true.)
+    if (rc /= EMPM_OK) return
+    call empm_comm_from_handle(handle, comm, info)
+    if (info /= 0) then
+      rc = fail(b, EMPM_ERR_USAGE, 'empm_model_set_comm: '//empm_comm_handle_problem(info))
+      return
+    end if
+    call b%model%comm%finish()
+    b%model%comm = comm
+    b%message = ''
+  end function capi_set_comm
 
   !> New handle from a case file (read with extra_groups='verify'), finalized and ready to step.
   integer function capi_from_case(path, h, msg) result(rc)
@@ -435,6 +483,15 @@ contains
         ''' does not support frictional walls ('//WALL_SCHEMES//' do)'); return
     end if
     call b%model%finalize_setup(e)
+    if (e%code == EMPM_OK .and. b%model%comm%parallel()) then
+      ! Every process added every particle: each keeps those of its box.
+      if (b%model%comm%min_int(b%model%pts%np) /= b%model%comm%max_int(b%model%pts%np)) then
+        rc = fail(b, EMPM_ERR_USAGE, 'empm_model_finalize: the processes added different '// &
+          'numbers of particles (each must add all of them; finalize shares them out)')
+        return
+      end if
+      call empm_partition_particles(b%model, e)
+    end if
     if (e%code == EMPM_OK) call b%hist%init(b%model%grid%ndim, b%probe_name, b%probe_particle, &
                                             1024, 0, e)
     if (e%code == EMPM_OK) b%ready = .true.
@@ -492,7 +549,7 @@ contains
       ncomp = b%model%grid%ndim
     case ('stress', 'strain')
       ncomp = 6
-    case ('mass', 'volume', 'density')
+    case ('mass', 'volume', 'density', 'id')
       ncomp = 1
     case default
       ! A state variable by the name its material gives it.
@@ -509,7 +566,7 @@ contains
       end if
       if (row == 0) then
         rc = fail(b, EMPM_ERR_USAGE, 'unknown particle field "'//field//'" (x, v, stress, '// &
-                  'strain, mass, volume, density or a state variable name)')
+                  'strain, mass, volume, density, id or a state variable name)')
         return
       end if
       if (.not. b%ready) then
@@ -543,6 +600,7 @@ contains
       case ('mass'); buf(1:n) = pts%m(1:np)
       case ('volume'); buf(1:n) = pts%vol(1:np)
       case ('density'); buf(1:n) = pts%rho(1:np)
+      case ('id'); buf(1:n) = real(pts%id(1:np), wp)
       case default; buf(1:n) = pts%state(row, 1:np)
       end select
     end associate
@@ -557,6 +615,9 @@ contains
     integer :: nf, nc, row, np
     rc = capi_field_size(b, field, nf, nc, row)
     if (rc /= EMPM_OK) return
+    if (field == 'id') then
+      rc = fail(b, EMPM_ERR_USAGE, 'field "id" is read-only'); return
+    end if
     if (n /= nf) then
       rc = size_error(b, field, n, nf); return
     end if
@@ -648,8 +709,24 @@ contains
     meta%case_file = b%case_file; meta%case_text = b%case_text
     meta%shape = b%shape_name; meta%integrator = b%scheme_name
     meta%cfl = b%run%cfl; meta%t_end = b%model%t
-    call empm_write_results(trim(path), b%model, b%hist, meta, .true., '', e)
+    if (b%model%comm%parallel()) then
+      ! The root gathers every particle into a copy (the model goes on with its share).
+      call write_gathered()
+    else
+      call empm_write_results(trim(path), b%model, b%hist, meta, .true., '', e)
+    end if
     rc = remember(b, e)
+  contains
+    subroutine write_gathered()
+      type(empm_model_t), allocatable :: whole
+      type(empm_history_t), allocatable :: hall
+      allocate(whole, source=b%model)
+      allocate(hall, source=b%hist)
+      call empm_gather_particles(whole, hall, e)
+      if (e%code == EMPM_OK .and. whole%comm%is_root()) &
+        call empm_write_results(trim(path), whole, hall, meta, .true., '', e)
+      call empm_agree_error(b%model%comm, e)
+    end subroutine write_gathered
   end function capi_write
 
   !> Free a handle (nothing for a null one).
@@ -657,7 +734,9 @@ contains
     type(c_ptr), intent(in) :: h !! handle
     type(empm_capi_box_t), pointer :: b
     b => capi_box(h)
-    if (associated(b)) deallocate(b)
+    if (.not. associated(b)) return
+    call b%model%comm%finish() ! frees a host communicator's duplicate (MPI stays the host's)
+    deallocate(b)
   end subroutine capi_destroy
 
   ! ---- C entry points ----------------------------------------------------------------------
@@ -685,6 +764,31 @@ contains
     rc = capi_run_case(fstr(path), fstr(output), msg)
     call capi_copy_message(msg, errbuf, errlen)
   end function c_run_case
+
+  !> `empm_run_case_file` on the processes of a host's communicator, given by its Fortran
+  !> handle (`MPI_Comm_c2f(comm)`); every process calls it with the same arguments.
+  integer(c_int) function c_run_case_comm(path, output, fcomm, errbuf, errlen) result(rc) &
+      bind(C, name='empm_run_case_file_comm')
+    type(c_ptr), value :: path             !! const char *: case file
+    type(c_ptr), value :: output           !! const char *: output override or NULL
+    integer(c_int), value :: fcomm         !! MPI_Fint: the communicator's Fortran handle
+    type(c_ptr), value :: errbuf           !! char *: message buffer or NULL
+    integer(c_size_t), value :: errlen     !! its size
+    character(len=:), allocatable :: msg
+    if (.not. c_associated(path)) then
+      rc = EMPM_ERR_USAGE
+      call capi_copy_message('empm_run_case_file_comm: path is NULL', errbuf, errlen); return
+    end if
+    rc = capi_run_case_comm(fstr(path), fstr(output), int(fcomm), msg)
+    call capi_copy_message(msg, errbuf, errlen)
+  end function c_run_case_comm
+
+  !> `empm_model_set_comm`: run the model on a host's communicator (Fortran handle).
+  integer(c_int) function c_set_comm(m, fcomm) result(rc) bind(C, name='empm_model_set_comm')
+    type(c_ptr), value :: m                !! empm_model *
+    integer(c_int), value :: fcomm         !! MPI_Fint: the communicator's Fortran handle
+    rc = capi_set_comm(capi_box(m), int(fcomm))
+  end function c_set_comm
 
   !> New model from a case file; on failure *out = NULL and the message goes to errbuf.
   integer(c_int) function c_from_case(path, out, errbuf, errlen) result(rc) &

@@ -19,7 +19,7 @@ module empm_f77
                        capi_set_integrator, capi_add_material, capi_add_particles, capi_fix_box, &
                        capi_set_time_step, capi_finalize, capi_step, capi_advance_to, &
                        capi_get_field, capi_set_field, capi_energies, capi_write, capi_destroy, &
-                       capi_set_gravity, capi_friction_box
+                       capi_set_gravity, capi_friction_box, capi_set_comm, capi_run_case_comm
   use empm_error, only: EMPM_ERR_USAGE
   implicit none
   private
@@ -228,6 +228,33 @@ contains
     ierr = capi_friction_box(capi_box(to_ptr(model)), lo, hi, int(normal), delta, k)
     nsel = k
   end subroutine f77_fricbox
+
+  !> `CALL EMPM_SETCOMM(MODEL, ICOMM, IERR)`: before finalize, run the model on the processes
+  !> of the INTEGER communicator ICOMM (mpif.h); every process then makes the same calls and
+  !> adds every particle (docs/embedding.md, "MPI").
+  subroutine f77_setcomm(model, icomm, ierr) bind(C, name='empm_setcomm_')
+    integer(c_int64_t), intent(in) :: model  !! handle
+    integer(c_int), intent(in) :: icomm      !! the communicator (Fortran handle)
+    integer(c_int), intent(out) :: ierr      !! status
+    ierr = capi_set_comm(capi_box(to_ptr(model)), int(icomm))
+  end subroutine f77_setcomm
+
+  !> `CALL EMPM_RUNCOMM(PATH, OUTPUT, ICOMM, MSG, IERR)`: run a case file on the processes of
+  !> ICOMM (every one calls); OUTPUT blank for the case's file; MSG the error, blank on success.
+  subroutine f77_runcomm(path, output, icomm, msg, ierr, npath, nout, nmsg) &
+      bind(C, name='empm_runcomm_')
+    character(kind=c_char), intent(in) :: path(*)   !! case file
+    character(kind=c_char), intent(in) :: output(*) !! output override or blank
+    integer(c_int), intent(in) :: icomm             !! the communicator (Fortran handle)
+    character(kind=c_char), intent(out) :: msg(*)   !! error text, blank on success
+    integer(c_int), intent(out) :: ierr             !! status
+    integer(c_size_t), value :: npath               !! hidden length of PATH
+    integer(c_size_t), value :: nout                !! hidden length of OUTPUT
+    integer(c_size_t), value :: nmsg                !! hidden length of MSG
+    character(len=:), allocatable :: text
+    ierr = capi_run_case_comm(fstr(path, npath), fstr(output, nout), int(icomm), text)
+    call fput(text, msg, nmsg)
+  end subroutine f77_runcomm
 
   !> `CALL EMPM_TIMESTEP(MODEL, CFL, DT, IERR)`: DT = 0 for CFL times the stable step.
   subroutine f77_timestep(model, cfl, dt, ierr) bind(C, name='empm_timestep_')

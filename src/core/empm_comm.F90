@@ -11,12 +11,13 @@ module empm_comm
     MPI_Finalize, MPI_Finalized, MPI_Comm_rank, MPI_Comm_size, MPI_Comm_dup, MPI_Comm_free, &
     MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_SUM, &
     MPI_Op, MPI_MAX, MPI_MIN, MPI_LOR, MPI_Bcast, MPI_Alltoall, MPI_Alltoallv, MPI_CHARACTER, &
-    MPI_Gather, MPI_Gatherv, MPI_Barrier, &
-    operator(/=)
+    MPI_Gather, MPI_Gatherv, MPI_Barrier, MPI_Allgather, MPI_Request, MPI_Isend, MPI_Irecv, &
+    MPI_Waitall, MPI_STATUSES_IGNORE, operator(/=)
 #endif
   implicit none
   private
-  public :: empm_comm_t, empm_comm_world, empm_comm_serial, EMPM_MPI_BUILT
+  public :: empm_comm_t, empm_comm_world, empm_comm_serial, empm_comm_from_handle, &
+            empm_comm_handle_problem, EMPM_MPI_BUILT
 
 #ifdef EMPM_USE_MPI
   logical, parameter :: EMPM_MPI_BUILT = .true.  !! this build can run on several processes
@@ -50,6 +51,8 @@ module empm_comm
     procedure :: bcast_text => comm_bcast_text
     procedure :: gather_rows => comm_gather_rows
     procedure :: exchange_rows => comm_exchange_rows
+    procedure :: allgather_ints => comm_allgather_ints
+    procedure :: swap => comm_swap
     procedure :: barrier => comm_barrier
     procedure :: finish => comm_finish
   end type empm_comm_t
@@ -87,6 +90,52 @@ contains
     comm = empm_comm_serial()
 #endif
   end function empm_comm_world
+
+  !> The processes of a host's communicator, given by its Fortran handle: `MPI_Comm_c2f(comm)`
+  !> in C, the INTEGER communicator of `mpif.h` or the `mpi` module, `comm%MPI_VAL` of
+  !> `mpi_f08`. empm works on a private duplicate (its messages never meet the host's), which
+  !> [[empm_comm_t:finish]] frees; MPI stays the host's to end. `info`: 0, or what
+  !> [[empm_comm_handle_problem]] explains (the result is then serial).
+  subroutine empm_comm_from_handle(handle, comm, info)
+    integer, intent(in) :: handle            !! the host's communicator (Fortran handle)
+    type(empm_comm_t), intent(out) :: comm   !! its processes
+    integer, intent(out) :: info             !! 0; 1 no MPI in this build; 2 MPI not started;
+                                             !! 3 MPI_COMM_NULL
+#ifdef EMPM_USE_MPI
+    type(MPI_Comm) :: host
+    logical :: up
+    comm = empm_comm_serial()
+    call MPI_Initialized(up)
+    if (.not. up) then
+      info = 2; return
+    end if
+    if (handle == MPI_COMM_NULL%MPI_VAL) then
+      info = 3; return
+    end if
+    info = 0
+    host%MPI_VAL = handle
+    call MPI_Comm_dup(host, comm%handle)
+    call MPI_Comm_rank(comm%handle, comm%rank)
+    call MPI_Comm_size(comm%handle, comm%nranks)
+#else
+    associate (unused => handle); end associate
+    comm = empm_comm_serial()
+    info = 1
+#endif
+  end subroutine empm_comm_from_handle
+
+  !> What a status of [[empm_comm_from_handle]] means ('' for 0).
+  pure function empm_comm_handle_problem(info) result(text)
+    integer, intent(in) :: info             !! status
+    character(len=:), allocatable :: text   !! explanation
+    select case (info)
+    case (0); text = ''
+    case (1); text = 'this empm was built without MPI (configure with -DEMPM_USE_MPI=ON)'
+    case (2); text = 'MPI is not initialized: call MPI_Init before handing empm a communicator'
+    case (3); text = 'the communicator is MPI_COMM_NULL'
+    case default; text = 'unknown communicator status'
+    end select
+  end function empm_comm_handle_problem
 
 #ifdef EMPM_USE_MPI
   ! A process launcher (mpirun, mpiexec, srun) started this program.
@@ -369,6 +418,52 @@ contains
                        m * rdisp, MPI_DOUBLE_PRECISION, self%handle)
 #endif
   end subroutine comm_exchange_rows
+
+  !> Every process gets every process's integers: all(:, r + 1) = process r's `mine`.
+  subroutine comm_allgather_ints(self, mine, all)
+    class(empm_comm_t), intent(in) :: self          !! communicator
+    integer, intent(in), contiguous :: mine(:)      !! this process's values
+    integer, intent(out), contiguous :: all(:,:)    !! (size(mine), nranks)
+    if (self%nranks <= 1) then
+      all(:, 1) = mine
+      return
+    end if
+#ifdef EMPM_USE_MPI
+    call MPI_Allgather(mine, size(mine), MPI_INTEGER, all, size(mine), MPI_INTEGER, &
+                       self%handle)
+#endif
+  end subroutine comm_allgather_ints
+
+  !> Point-to-point swap with neighbours: segment k of `sbuf`, entries
+  !> m (ptr(k) − 1) + 1 .. m (ptr(k+1) − 1), goes to process nbr(k), which sends back as many
+  !> values into the same segment of `rbuf` (symmetric overlaps: both sides agree on ptr).
+  subroutine comm_swap(self, nbr, ptr, m, sbuf, rbuf)
+    class(empm_comm_t), intent(in) :: self                         !! communicator
+    integer, intent(in) :: nbr(:)                                  !! neighbour processes
+    integer, intent(in) :: ptr(:)                                  !! segment starts (size(nbr)+1)
+    integer, intent(in) :: m                                       !! values per entry
+    real(wp), intent(in), contiguous, asynchronous :: sbuf(:)      !! values to send
+    real(wp), intent(inout), contiguous, asynchronous :: rbuf(:)   !! values received
+#ifdef EMPM_USE_MPI
+    type(MPI_Request) :: req(2 * size(nbr))
+    integer :: k, i0, i1
+    integer, parameter :: TAG = 7301
+    if (self%nranks <= 1 .or. size(nbr) == 0) return
+    do k = 1, size(nbr)
+      i0 = m * (ptr(k) - 1) + 1; i1 = m * (ptr(k + 1) - 1)
+      call MPI_Irecv(rbuf(i0:i1), i1 - i0 + 1, MPI_DOUBLE_PRECISION, nbr(k), TAG, &
+                     self%handle, req(k))
+    end do
+    do k = 1, size(nbr)
+      i0 = m * (ptr(k) - 1) + 1; i1 = m * (ptr(k + 1) - 1)
+      call MPI_Isend(sbuf(i0:i1), i1 - i0 + 1, MPI_DOUBLE_PRECISION, nbr(k), TAG, &
+                     self%handle, req(size(nbr) + k))
+    end do
+    call MPI_Waitall(2 * size(nbr), req, MPI_STATUSES_IGNORE)
+#else
+    associate (unused => [nbr, ptr, m], unused_s => sbuf, unused_r => rbuf); end associate
+#endif
+  end subroutine comm_swap
 
   !> Wait for every process.
   subroutine comm_barrier(self)

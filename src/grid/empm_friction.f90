@@ -88,8 +88,9 @@ contains
 
   !> Add the friction forces to `f` (module header) and their sum per reaction set to
   !> `reaction` (the force the wall exerts on the body). Tangential dofs fixed by another
-  !> boundary (`fixed`) are left alone; nodes without mass carry no friction.
-  pure subroutine friction_apply(self, mass, fixed, v, h, f, reaction)
+  !> boundary (`fixed`) are left alone; nodes without mass carry no friction. With `mask`,
+  !> only the nodes it marks add to `reaction` (a parallel run's owned nodes).
+  pure subroutine friction_apply(self, mass, fixed, v, h, f, reaction, mask)
     class(empm_friction_t), intent(inout) :: self   !! walls (kept is set)
     real(wp), intent(in) :: mass(:)                 !! nodal masses (nnode) [kg]
     logical, intent(in) :: fixed(:,:)               !! Dirichlet mask (ndim, nnode)
@@ -97,6 +98,7 @@ contains
     real(wp), intent(in) :: h                       !! time over which f/m is added to v [s]
     real(wp), intent(inout) :: f(:,:)               !! total nodal force (ndim, nnode) [N]
     real(wp), intent(inout) :: reaction(:,:)        !! reaction per set (ndim, nset) [N]
+    logical, intent(in), optional :: mask(:)        !! nodes whose friction the reaction counts
     real(wp) :: q(3), fmu(3), qn, cap, load
     integer :: k, id, a, d, nd
     logical :: t(3)
@@ -126,7 +128,11 @@ contains
         f(d, id) = f(d, id) + fmu(d)
         self%kept(d, k) = f(d, id)
       end do
-      if (self%set(k) > 0) reaction(1:nd, self%set(k)) = reaction(1:nd, self%set(k)) + fmu(1:nd)
+      if (self%set(k) == 0) cycle
+      if (present(mask)) then
+        if (.not. mask(id)) cycle
+      end if
+      reaction(1:nd, self%set(k)) = reaction(1:nd, self%set(k)) + fmu(1:nd)
     end do
   end subroutine friction_apply
 

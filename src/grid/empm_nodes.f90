@@ -357,12 +357,14 @@ contains
   !> The frictional walls' forces added to the total nodal force `f` (before the fixed dofs
   !> are zeroed: the normal load is read from it), with the nodal velocities `v` of the step
   !> and the time `h` over which f/m is added to them; the reaction sets include them.
-  pure subroutine nodes_apply_friction(self, v, h, f)
+  pure subroutine nodes_apply_friction(self, v, h, f, mask)
     class(empm_nodes_t), intent(inout) :: self     !! nodal fields
     real(wp), intent(in), contiguous :: v(:,:)     !! nodal velocities (ndim, nnode) [m/s]
     real(wp), intent(in) :: h                      !! time over which f/m is added to v [s]
     real(wp), intent(inout), contiguous :: f(:,:)  !! total nodal force (ndim, nnode) [N]
-    call self%fric%apply(self%mass, self%fixed, v, h, f, self%reaction)
+    logical, intent(in), optional :: mask(:)       !! nodes whose friction the reactions count
+                                                   !! (nnode); all when absent
+    call self%fric%apply(self%mass, self%fixed, v, h, f, self%reaction, mask)
   end subroutine nodes_apply_friction
 
   !> Put back the walls' tangential forces after a pass that changed every dof (damping).
@@ -411,22 +413,32 @@ contains
   !> = −Σ f_I, the prescribed velocities being constant in time. R is the force the support
   !> exerts on the body (a base carrying a body's weight W pushes up: R = +W along the up axis).
   !> A dof in several sets counts in each.
-  pure subroutine nodes_compute_reactions(self, f)
+  pure subroutine nodes_compute_reactions(self, f, mask)
     class(empm_nodes_t), intent(inout) :: self     !! nodal fields (reaction is set)
     real(wp), intent(in), contiguous :: f(:,:)     !! total nodal force (ndim, nnode) [N]
-    call set_sums(self%nset, self%ndim, self%set_ptr, self%set_dof, f, self%reaction)
+    logical, intent(in), optional :: mask(:)       !! the nodes to count (nnode), e.g. those a
+                                                   !! process owns; all when absent
+    if (present(mask)) then
+      call set_sums(self%nset, self%ndim, self%set_ptr, self%set_dof, f, self%reaction, mask)
+    else
+      call set_sums(self%nset, self%ndim, self%set_ptr, self%set_dof, f, self%reaction)
+    end if
   end subroutine nodes_compute_reactions
 
-  pure subroutine set_sums(nset, nd, ptr, dofs, f, r)
+  pure subroutine set_sums(nset, nd, ptr, dofs, f, r, mask)
     integer, intent(in) :: nset, nd
     integer, intent(in) :: ptr(nset + 1), dofs(*)
     real(wp), intent(in) :: f(*)
     real(wp), intent(out) :: r(nd, nset)
+    logical, intent(in), optional :: mask(:)
     integer :: s, k, j
     r = 0.0_wp
     do s = 1, nset
       do k = ptr(s), ptr(s + 1) - 1
         j = dofs(k)
+        if (present(mask)) then
+          if (.not. mask((j - 1) / nd + 1)) cycle
+        end if
         r(mod(j - 1, nd) + 1, s) = r(mod(j - 1, nd) + 1, s) - f(j)
       end do
     end do

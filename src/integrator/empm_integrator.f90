@@ -205,7 +205,7 @@ contains
     if (stat%code /= 0) return
     call model%nodes%reset()
     call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
-    call model%comm%sum(model%nodes%mass)
+    call model%halo%sum(model%comm, model%nodes%mass)
     call extend_masses(self, model)
     model%nodes%vel = 0.0_wp ! no damping in this assembly
     call self%assemble_forces(model, model%t)
@@ -230,7 +230,7 @@ contains
     if (stat%code /= 0) return
     call model%nodes%reset()
     call p2g_mass(model%basis, model%pts%m, model%nodes%mass)
-    call model%comm%sum(model%nodes%mass)
+    call model%halo%sum(model%comm, model%nodes%mass)
     call extend_masses(self, model)
     call self%assemble_forces(model, model%t)
     call nodal_divide_by_mass(model%nodes, model%nodes%force, model%nodes%acc)
@@ -267,7 +267,37 @@ contains
       call ws%set_ranges(model%basis)
     end if
     call agree_status(model, stat)
+    if (stat%code == 0 .and. model%comm%parallel()) call share_region(model)
   end subroutine eval_basis
+
+  !> Parallel runs: the nodes this process's particles reach on the new basis (the box of their
+  !> cells widened by the family's reach), agreed with the other processes ([[empm_halo]]).
+  subroutine share_region(model)
+    type(empm_model_t), intent(inout) :: model !! simulation state
+    real(wp) :: xlo(3), xhi(3)
+    integer :: lo(3), hi(3), d, p, nd, reach
+    nd = model%grid%ndim
+    reach = model%shape%reach_cells(model%grid)
+    ! A traction acts at its face centre, up to a particle's size past the particle.
+    if (model%loads%ntraction() > 0) reach = reach + 1
+    lo = 0; hi = -1
+    if (model%pts%np > 0) then
+      xlo = 0.0_wp; xhi = 0.0_wp
+      do d = 1, nd
+        xlo(d) = huge(1.0_wp); xhi(d) = -huge(1.0_wp)
+        do p = 1, model%pts%np
+          xlo(d) = min(xlo(d), model%pts%x(d, p)); xhi(d) = max(xhi(d), model%pts%x(d, p))
+        end do
+      end do
+      lo = 0; hi = 0
+      do d = 1, nd
+        ! Node c is at origin + c h: a particle in cell c reaches nodes c − reach .. c + 1 + reach.
+        lo(d) = floor((xlo(d) - model%grid%origin(d)) * model%grid%inv_h(d)) - reach
+        hi(d) = floor((xhi(d) - model%grid%origin(d)) * model%grid%inv_h(d)) + 1 + reach
+      end do
+    end if
+    call model%halo%update(model%comm, model%grid, lo, hi, reach)
+  end subroutine share_region
 
   !> Every process takes the failure the serial run would report (that of the particle with
   !> the smallest id), or none: the processes leave a step together, before its next
@@ -310,7 +340,7 @@ contains
       if (.not. repeat) model%pts%vol_fill(1:np) = model%pts%vol(1:np)
       nodes%vol = 0.0_wp
       call p2g_mass(model%basis, model%pts%vol_fill, nodes%vol, self%p2g)
-      call model%comm%sum(nodes%vol)
+      call model%halo%sum(model%comm, nodes%vol)
       call nodes%find_degenerate(model%grid)
       if (nodes%ext%n > 0) call nodes%ext%gather_mass(nodes%mass)
     end associate
@@ -369,7 +399,7 @@ contains
         else
           call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom, self%p2g)
         end if
-        call model%comm%sum(nodes%mom)
+        call model%halo%sum(model%comm, nodes%mom)
       else
         again = self%reeval
         call eval_basis(model, stat, tm, self%p2g, again)
@@ -383,8 +413,8 @@ contains
           call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
                                  self%p2g)
         end if
-        call model%comm%sum(nodes%mass)
-        call model%comm%sum(nodes%mom)
+        call model%halo%sum(model%comm, nodes%mass)
+        call model%halo%sum(model%comm, nodes%mom)
         call extend_masses(self, model, again)
       end if
       call tm%lap(PHASE_P2G)
@@ -411,7 +441,7 @@ contains
     real(wp), intent(in) :: t                       !! time at which loads are evaluated [s]
     real(wp), intent(in), optional :: kick          !! time over which f/m is added to v_I [s]
     real(wp) :: g(3), fext2, funb
-    integer :: np, d
+    integer :: np, d, i
     logical :: use_b
     np = model%pts%np; d = model%grid%ndim
     model%nodes%force = 0.0_wp
@@ -423,25 +453,51 @@ contains
                                                 model%pts%x(:, 1:np), self%bwork(:, 1:np))
     call p2g_body_force(model%basis, model%pts%m, g(1:d), self%bwork, use_b, model%nodes%force, &
                         self%p2g)
-    call model%comm%sum(model%nodes%force)
+    call model%halo%sum(model%comm, model%nodes%force)
     if (model%loads%ntraction() > 0) then
       ! The tractions' nodal forces apart (for the residual's ‖f_ext‖), then added.
       self%tforce = 0.0_wp
       call p2g_tractions(model, t, self%tforce)
-      call model%comm%sum(self%tforce)
+      call model%halo%sum(model%comm, self%tforce)
       model%nodes%force = model%nodes%force + self%tforce
     end if
-    if (model%nodes%nset > 0) call model%nodes%compute_reactions(model%nodes%force)
-    if (model%nodes%fric%n > 0 .and. present(kick)) &
-      call model%nodes%apply_friction(model%nodes%vel, kick, model%nodes%force)
+    if (model%halo%active) then
+      ! Each node's share of a reaction counted once, by the process that owns it, then summed.
+      if (model%nodes%nset > 0) &
+        call model%nodes%compute_reactions(model%nodes%force, model%halo%owned)
+      if (model%nodes%fric%n > 0 .and. present(kick)) &
+        call model%nodes%apply_friction(model%nodes%vel, kick, model%nodes%force, &
+                                        model%halo%owned)
+      if (model%nodes%nset > 0) call model%comm%sum(model%nodes%reaction)
+    else
+      if (model%nodes%nset > 0) call model%nodes%compute_reactions(model%nodes%force)
+      if (model%nodes%fric%n > 0 .and. present(kick)) &
+        call model%nodes%apply_friction(model%nodes%vel, kick, model%nodes%force)
+    end if
     call model%nodes%constrain_force(model%nodes%force)
     if (model%track) then
-      if (model%loads%ntraction() > 0) then
+      if (model%halo%active) then
+        ! Each node counted once, by the process that owns it.
+        associate (own => model%halo%owned)
+          if (model%loads%ntraction() > 0) then
+            fext2 = ext_norm2(model%nodes%mass, g(1:d), self%tforce, own)
+          else
+            fext2 = sum(model%nodes%mass**2, mask=own) * sum(g(1:d)**2)
+          end if
+          funb = 0.0_wp
+          do i = 1, model%nodes%nnode
+            if (own(i)) funb = funb + sum(model%nodes%force(:, i)**2)
+          end do
+        end associate
+        fext2 = model%comm%sum_real(fext2)
+        funb = sqrt(model%comm%sum_real(funb))
+      else if (model%loads%ntraction() > 0) then
         fext2 = ext_norm2(model%nodes%mass, g(1:d), self%tforce)
+        funb = sqrt(sum(model%nodes%force**2))
       else
         fext2 = sum(model%nodes%mass**2) * sum(g(1:d)**2)
+        funb = sqrt(sum(model%nodes%force**2))
       end if
-      funb = sqrt(sum(model%nodes%force**2))
       if (fext2 > 0.0_wp) then
         model%residual = funb / sqrt(fext2)
       else
@@ -455,13 +511,17 @@ contains
   end subroutine assemble_forces
 
   !> Σ_I |m_I g + t_I|², the squared norm of the nodal external force (gravity and tractions).
-  pure real(wp) function ext_norm2(mass, g, tf) result(s)
+  pure real(wp) function ext_norm2(mass, g, tf, mask) result(s)
     real(wp), intent(in) :: mass(:)     !! nodal masses
     real(wp), intent(in) :: g(:)        !! gravity (ndim)
     real(wp), intent(in) :: tf(:,:)     !! nodal traction forces (ndim, nnode)
+    logical, intent(in), optional :: mask(:) !! the nodes to count (nnode); all when absent
     integer :: i
     s = 0.0_wp
     do i = 1, size(mass)
+      if (present(mask)) then
+        if (.not. mask(i)) cycle
+      end if
       s = s + sum((mass(i) * g + tf(:, i))**2)
     end do
   end function ext_norm2
@@ -484,6 +544,7 @@ contains
         if (s == 0.0_wp) cycle
         do j = 1, size(tr%part)
           p = tr%part(j)
+          if (p == 0) cycle ! another process holds it
           fp(1:nd) = (s * tr%area(j)) * tr%traction(1:nd)
           xf(1:nd) = model%pts%x(:, p)
           xf(tr%axis) = xf(tr%axis) + tr%side * tr%offset(j)
@@ -745,8 +806,8 @@ contains
     integ%vs_mass = 0.0_wp; integ%vs_q = 0.0_wp
     call p2g_mass(model%basis, model%pts%m(1:np), integ%vs_mass, integ%p2g)
     call p2g_mass(model%basis, integ%vs_w(1:np), integ%vs_q, integ%p2g)
-    call model%comm%sum(integ%vs_mass)
-    call model%comm%sum(integ%vs_q)
+    call model%halo%sum(model%comm, integ%vs_mass)
+    call model%halo%sum(model%comm, integ%vs_q)
     ! Mirror planes: the volumetric rate is even about the plane, so a ghost's share adds to its
     ! image and the ghost takes the image's value.
     call model%nodes%mirror_gather_even(integ%vs_mass)

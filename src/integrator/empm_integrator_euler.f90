@@ -102,7 +102,7 @@ contains
         ! Re-map momentum from the updated particle velocities (Sulsky's MUSL).
         nodes%mom = 0.0_wp
         call p2g_weighted(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mom, self%p2g)
-        call model%comm%sum(nodes%mom)
+        call model%halo%sum(model%comm, nodes%mom)
         call tm%lap(PHASE_P2G)
         call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)
         call nodes%constrain_velocity(nodes%vel, nodes%mom)

@@ -134,7 +134,7 @@ contains
       ! a_I^k in nodes%work (mass-weighted map of particle accelerations, accumulated in acc).
       nodes%acc = 0.0_wp
       call p2g_weighted(basis, pts%m, pts%a, 0.0_wp, pts%a, nodes%acc, self%p2g)
-      call model%comm%sum(nodes%acc)
+      call model%halo%sum(model%comm, nodes%acc)
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%acc, nodes%work)
       call nodes%constrain_force(nodes%work)

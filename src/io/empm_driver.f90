@@ -21,7 +21,7 @@ module empm_driver
   use empm_partition, only: empm_partition_particles, empm_gather_particles
   implicit none
   private
-  public :: empm_run_case
+  public :: empm_run_case, empm_agree_error
 
   ! Checkpoints next to the results file, and the stop signal the program caught (if it
   ! installed the handlers: `empm run` does, the library does not).
@@ -55,7 +55,7 @@ contains
     call empm_gather_particles(whole, hwhole, err)
     if (err%code == EMPM_OK .and. model%comm%is_root()) &
       call empm_checkpoint_write(self%path, self%prev, whole, hwhole, state, self%case_text, err)
-    call agree_first_error(model%comm, err)
+    call empm_agree_error(model%comm, err)
   end subroutine hook_checkpoint
 
   integer function hook_stop(self) result(sig)
@@ -64,10 +64,11 @@ contains
     sig = empm_stop_signal()
   end function hook_stop
 
-  ! Every process of `comm` takes the error of the first process that has one (or none).
-  subroutine agree_first_error(comm, e)
-    type(empm_comm_t), intent(in) :: comm
-    type(empm_error_t), intent(inout) :: e
+  !> Every process of `comm` takes the error of the first process that has one (or none).
+  !> Collective.
+  subroutine empm_agree_error(comm, e)
+    type(empm_comm_t), intent(in) :: comm      !! the processes
+    type(empm_error_t), intent(inout) :: e     !! this process's outcome in, the first one out
     integer :: first, v(1)
     character(len=:), allocatable :: text
     if (.not. comm%parallel()) return
@@ -81,7 +82,7 @@ contains
     if (comm%rank /= first) then
       e%code = v(1); e%message = text
     end if
-  end subroutine agree_first_error
+  end subroutine empm_agree_error
 
   !> Run the case in `path`, writing HDF5 to `output` (default: the case's &output file).
   !> Exit-status semantics when `err` is absent: 2 invalid input, 3 run-time guard, 4 I/O.
@@ -140,7 +141,7 @@ contains
     call empm_read_case(path, cs, e, extra_groups=extra_groups)
     ! Each process reads the case: one that cannot (a file missing on its machine) must not
     ! leave the others waiting. All take the error of the first process that has one.
-    if (present(comm)) call agree_first_error(comm, e)
+    if (present(comm)) call empm_agree_error(comm, e)
     if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
     end if
@@ -157,19 +158,12 @@ contains
       if (present(auto_threads)) then
         if (auto_threads) call empm_set_threads(1)
       end if
-      if ((resumed .or. cs%run%checkpoint_every > 0 .or. cs%run%checkpoint_seconds > 0.0_wp) &
-          .and. cs%model%loads%ntraction() > 0) then
-        call e%set(EMPM_ERR_INPUT, path//': checkpoints (&output checkpoint_every, '// &
-          'checkpoint_seconds, --restart) of a case with surface tractions (&traction) are '// &
-          'not available on several processes yet (docs/parallel.md); run on one process')
-        call empm_raise_error(e, err); return
-      end if
     else if (present(auto_threads)) then
       if (auto_threads) call choose_threads()
     end if
     ! The root claims the output for all (one file, one lock); its verdict is everyone's.
     if (cs%model%comm%is_root()) call empm_output_claim(cs%output_file, e)
-    call agree_first_error(cs%model%comm, e)
+    call empm_agree_error(cs%model%comm, e)
     if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
     end if
@@ -188,7 +182,7 @@ contains
       ! Every process reads the whole checkpoint (written by any number of processes: it
       ! holds every particle in id order), then takes its share below.
       call empm_checkpoint_read(trim(restart), cs%model, hist, sst, cs%text, warning, e)
-      call agree_first_error(cs%model%comm, e)
+      call empm_agree_error(cs%model%comm, e)
       if (e%code /= EMPM_OK) then
         call release()
         call empm_raise_error(e, err); return
@@ -221,7 +215,7 @@ contains
         call empm_write_results(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
       end if
     end if
-    call agree_first_error(cs%model%comm, ew)
+    call empm_agree_error(cs%model%comm, ew)
     call release()
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then

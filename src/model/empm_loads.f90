@@ -52,7 +52,10 @@ module empm_loads
     real(wp) :: traction(3) = 0.0_wp        !! traction vector at full load [Pa]
     integer :: ramp = RAMP_NONE             !! RAMP_NONE, RAMP_LINEAR or RAMP_SINE
     real(wp) :: t_ramp = 0.0_wp             !! ramp time [s]
-    integer, allocatable :: part(:)         !! loaded particles
+    integer, allocatable :: part(:)         !! loaded particles (this process's index; on
+                                            !! several processes 0 for another's particle)
+    integer, allocatable :: pid(:)          !! their ids (several processes: set when they
+                                            !! are first shared out, then kept)
     real(wp), allocatable :: area(:)        !! reference face area of each [m^(ndim−1)]
     real(wp), allocatable :: offset(:)      !! distance from each particle to the loaded face
                                             !! along the outward normal [m] (fixed at set-up)

@@ -12,6 +12,7 @@ module empm_model
   use empm_material, only: empm_material_t, STATE_NAME_LEN
   use empm_loads, only: empm_loads_t
   use empm_comm, only: empm_comm_t
+  use empm_halo, only: empm_halo_t
   implicit none
   private
   public :: empm_model_t, empm_material_slot_t, empm_step_status_t
@@ -49,6 +50,8 @@ module empm_model
     type(empm_comm_t) :: comm                           !! the processes sharing the run: each
                                                         !! holds its particles, all the grid
                                                         !! (docs/parallel.md); serial default
+    type(empm_halo_t) :: halo                           !! nodal sums over the processes by
+                                                        !! neighbour exchange (parallel runs)
     integer, allocatable :: boxes(:,:,:)                !! the processes' boxes of cells,
                                                         !! first and last cell (3, 2, nranks)
     integer, allocatable :: boxes0(:,:,:)               !! the first ones (a static split's)

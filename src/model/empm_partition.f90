@@ -9,7 +9,7 @@ module empm_partition
   use empm_decomp, only: empm_rcb, empm_cell_of, empm_box_owner
   implicit none
   private
-  public :: empm_partition_particles, empm_gather_particles, empm_rebalance
+  public :: empm_partition_particles, empm_share_traction_state, empm_gather_particles, empm_rebalance
 
 contains
 
@@ -101,12 +101,14 @@ contains
   !> report the largest process's share over the mean: in the boxes being replaced, and in the
   !> first ones (what a split never re-cut would hold). `moved` is false when no particle
   !> changed process (the new boxes are kept), and with surface tractions (their particle lists
-  !> stay as they are, and so do the boxes). Serial: nothing changes.
-  subroutine empm_rebalance(model, before, static, moved, err)
+  !> stay as they are, and so do the boxes). `migrated` counts the particles that changed
+  !> process (all processes together). Serial: nothing changes.
+  subroutine empm_rebalance(model, before, static, moved, migrated, err)
     type(empm_model_t), intent(inout) :: model          !! model (shared among processes)
     real(wp), intent(out) :: before                     !! max/mean in the boxes replaced
     real(wp), intent(out) :: static                     !! max/mean in the first boxes
     logical, intent(out) :: moved                       !! the particles were redistributed
+    integer, intent(out) :: migrated                    !! particles that changed process
     type(empm_error_t), intent(inout), optional :: err  !! allocation failure, if present
     type(empm_error_t) :: e
     real(wp), allocatable :: rows(:,:), got(:,:), srt(:,:)
@@ -114,9 +116,8 @@ contains
     integer :: lo(3, model%comm%nranks), hi(3, model%comm%nranks), nc(3)
     integer :: p, np, m, oid, nd, ns, n
     real(wp) :: mass_tol
-    before = 1.0_wp; static = 1.0_wp; moved = .false.
+    before = 1.0_wp; static = 1.0_wp; moved = .false.; migrated = 0
     if (.not. model%comm%parallel() .or. .not. allocated(model%boxes)) return
-    if (model%loads%ntraction() > 0) return
     np = model%pts%np; nd = model%grid%ndim; ns = model%pts%nstate
     call cell_counts(model, nc, counts)
     call model%comm%sum_counts(counts)
@@ -126,7 +127,8 @@ contains
     call keep_boxes(model, lo, hi)
     ! Every particle to the process of its box; nothing to do when none changes process.
     dest = owners(model, lo, hi)
-    if (model%comm%sum_int(count(dest /= model%comm%rank)) == 0) return
+    migrated = model%comm%sum_int(count(dest /= model%comm%rank))
+    if (migrated == 0) return
     m = model%pts%row_size()
     allocate(rows(m, np))
     call model%pts%pack_rows([(p, p = 1, np)], rows)
@@ -144,6 +146,8 @@ contains
       call empm_raise_error(e, err); return
     end if
     model%nodes%mass_tol = mass_tol
+    call empm_share_traction_state(model)
+    call map_tractions(model)
     moved = .true.
 
   contains
@@ -166,6 +170,51 @@ contains
       share = maxval(per) / max(sum(per) / size(per), 1.0_wp)
     end function share
   end subroutine empm_rebalance
+
+  !> Every process gets the tractions' shape-function state (λ at each face centre, which
+  !> only the process holding the particle updates): before the particles move to other
+  !> processes, and before the root writes a checkpoint. Collective; serial: nothing.
+  subroutine empm_share_traction_state(model)
+    type(empm_model_t), intent(inout) :: model !! model (shared among processes)
+    integer :: k, j
+    if (.not. model%comm%parallel() .or. model%loads%ntraction() == 0) return
+    do k = 1, size(model%loads%tractions)
+      associate (tr => model%loads%tractions(k))
+        if (.not. allocated(tr%lam)) cycle
+        do j = 1, size(tr%part)
+          if (tr%part(j) == 0) tr%lam(:, j) = 0.0_wp
+        end do
+        call model%comm%sum(tr%lam)
+      end associate
+    end do
+  end subroutine empm_share_traction_state
+
+  ! After the particles moved: each traction entry's index on this process, from its particle's
+  ! id (a process's particles are in id order: a binary search), 0 when another holds it.
+  subroutine map_tractions(model)
+    type(empm_model_t), intent(inout) :: model
+    integer :: k, j, lo, hi, mid, np
+    if (model%loads%ntraction() == 0) return
+    np = model%pts%np
+    do k = 1, size(model%loads%tractions)
+      associate (tr => model%loads%tractions(k), id => model%pts%id)
+        do j = 1, size(tr%pid)
+          tr%part(j) = 0
+          lo = 1; hi = np
+          do while (lo <= hi)
+            mid = (lo + hi) / 2
+            if (id(mid) == tr%pid(j)) then
+              tr%part(j) = mid; exit
+            else if (id(mid) < tr%pid(j)) then
+              lo = mid + 1
+            else
+              hi = mid - 1
+            end if
+          end do
+        end do
+      end associate
+    end do
+  end subroutine map_tractions
 
   ! The permutation that sorts distinct integers increasingly (merge sort: n log n, stable).
   pure function id_order(key) result(idx)
@@ -207,13 +256,13 @@ contains
     sn%state = sn%state(:, mine); sn%id = sn%id(mine)
   end subroutine keep_snapshot
 
-  ! Each traction keeps the loaded particles this process holds, renumbered as they will be.
+  ! Each traction keeps every loaded particle, by id; those this process holds get their index
+  ! as it will be (the others 0), so that a re-cut or a restart can share them out again.
   subroutine keep_tractions(model, owner)
     type(empm_model_t), intent(inout) :: model
     integer, intent(in) :: owner(:)
-    integer, allocatable :: newidx(:), part(:)
-    real(wp), allocatable :: area(:), offset(:), lam(:,:)
-    integer :: k, j, n, p, q
+    integer, allocatable :: newidx(:)
+    integer :: k, j, p, q
     if (model%loads%ntraction() == 0) return
     allocate(newidx(size(owner)))
     q = 0
@@ -225,19 +274,10 @@ contains
     end do
     do k = 1, size(model%loads%tractions)
       associate (tr => model%loads%tractions(k))
-        n = count(newidx(tr%part) > 0)
-        allocate(part(n), area(n), offset(n))
-        if (allocated(tr%lam)) allocate(lam(size(tr%lam, 1), n))
-        q = 0
+        if (.not. allocated(tr%pid)) tr%pid = model%pts%id(tr%part)
         do j = 1, size(tr%part)
-          if (newidx(tr%part(j)) == 0) cycle
-          q = q + 1
-          part(q) = newidx(tr%part(j)); area(q) = tr%area(j); offset(q) = tr%offset(j)
-          if (allocated(tr%lam)) lam(:, q) = tr%lam(:, j)
+          tr%part(j) = newidx(tr%part(j))
         end do
-        call move_alloc(part, tr%part); call move_alloc(area, tr%area)
-        call move_alloc(offset, tr%offset)
-        if (allocated(lam)) call move_alloc(lam, tr%lam)
       end associate
     end do
   end subroutine keep_tractions

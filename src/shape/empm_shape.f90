@@ -77,6 +77,7 @@ module empm_shape
     procedure :: layout => shape_layout
     procedure :: configure => shape_configure
     procedure :: padding_cells => shape_padding_cells
+    procedure :: reach_cells => shape_reach_cells
   end type empm_shape_t
 
   abstract interface
@@ -160,6 +161,16 @@ contains
     associate (unused_ => self); end associate
     n = 0
   end function shape_padding_cells
+
+  !> Cells beyond a particle's own cell that its support can reach, along any direction (the
+  !> nodes of cells c − n .. c + 1 + n); the default, `padding_cells`, holds for the families
+  !> whose support is one cell (linear), or two with a margin of one (uGIMP, B-splines).
+  pure integer function shape_reach_cells(self, grid) result(n)
+    class(empm_shape_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid   !! background grid
+    associate (unused_ => grid); end associate
+    n = self%padding_cells()
+  end function shape_reach_cells
 
   !> Basis layout the family fills fastest on `grid`; the default is BASIS_LISTS, the only
   !> layout every family fills. A family overriding it must fill that layout in `eval_batch`.

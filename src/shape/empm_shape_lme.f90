@@ -153,6 +153,7 @@ module empm_shape_lme
     procedure :: set_gamma_nodes => lme_set_gamma_nodes
     procedure :: set_gamma_box => lme_set_gamma_box
     procedure :: support_radius => lme_radius
+    procedure :: reach_cells => lme_reach_cells
   end type empm_shape_lme_t
 
   interface
@@ -200,6 +201,13 @@ module empm_shape_lme
       class(empm_shape_lme_t), intent(in) :: self !! shape family
       character(len=:), allocatable :: s          !! identifier
     end function lme_name
+
+    !> Cells beyond a particle's own that its support reaches: ⌈R_max/h⌉ with the remedy's
+    !> enlargement (0 for invalid parameters).
+    module pure integer function lme_reach_cells(self, grid) result(n)
+      class(empm_shape_lme_t), intent(in) :: self !! shape family
+      type(empm_grid_t), intent(in) :: grid       !! background grid
+    end function lme_reach_cells
 
     !> Support radius R_max = h·sqrt(−ln tol0 / γ_min) [length], h the largest grid spacing
     !> (without the remedy's enlargement); 0 for invalid parameters.

@@ -109,6 +109,15 @@ contains
     s = trim(adjustl(buf))
   end procedure lme_format_gamma
 
+  module procedure lme_reach_cells
+    real(wp) :: rr
+    n = 0
+    if (.not. params_ok(self, grid)) return
+    rr = lme_radius(self, grid)
+    if (self%remedy == LME_REMEDY_ENLARGE) rr = rr / sqrt(LME_REMEDY_FACTOR**LME_REMEDY_TRIES)
+    n = maxval(ceiling(rr * grid%inv_h(1:grid%ndim)))
+  end procedure lme_reach_cells
+
   module procedure lme_max_nodes
     real(wp) :: rr, c, dd, dist2
     integer :: kk(3), i, j, k, d, ijk(3)

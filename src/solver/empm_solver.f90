@@ -7,7 +7,7 @@ module empm_solver
   use empm_error, only: empm_error_t, empm_raise, empm_raise_error, empm_alloc_error, &
                         EMPM_ERR_RUNTIME, EMPM_ERR_USAGE, EMPM_ERR_INTERRUPTED
   use empm_strings, only: str, join
-  use empm_partition, only: empm_rebalance
+  use empm_partition, only: empm_rebalance, empm_share_traction_state
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK, STEP_SHAPE_FAILED
   use empm_loads, only: RAMP_NONE
   use empm_integrator, only: empm_integrator_t
@@ -100,6 +100,9 @@ module empm_solver
     real(wp) :: imbalance = 1.0_wp      !! largest process's particles over the mean, just
                                         !! before a re-cut (the worst the boxes drifted to)
     real(wp) :: imbalance_static = 1.0_wp !! the same in the first boxes (a split never re-cut)
+    real(wp) :: halo_bytes = 0.0_wp     !! bytes of nodal partial sums the busiest process
+                                        !! sent per step to its neighbours
+    integer :: migrated = 0             !! particles that changed process at the re-cuts
   end type empm_run_stats_t
 
 contains
@@ -222,12 +225,12 @@ contains
     real(wp), allocatable :: tlam(:,:,:)
     real(wp) :: residual0
     integer(int64) :: clock_ckpt
-    integer :: sig, k
+    integer :: sig, k, inode
     type(empm_step_status_t) :: stat
     real(wp), allocatable :: psi(:)
     real(wp) :: dt, dt_stable, ekin, estr, egrav, t_good, t_next_snap
     integer :: isnap, nsnap, step_good, step_first
-    integer(int64) :: clock0, clock_last, clock, rate
+    integer(int64) :: clock0, clock_last, clock, rate, sent0
     logical :: show, tty, sample, suspect, summed
     type(empm_run_stats_t) :: st
     real(wp) :: t_report
@@ -286,6 +289,7 @@ contains
     nrep = keep ! a copy before the first step
     step_first = model%step
     st%nranks = model%comm%nranks
+    sent0 = model%halo%sent
     ! The work of a time-varying gravity needs the positions before each step.
     ramping = model%loads%ramp /= RAMP_NONE
     if (ramping) allocate(xprev(model%grid%ndim, model%pts%np))
@@ -361,8 +365,8 @@ contains
         if (summed) call sum_energies(model, ekin, estr, egrav)
       end if
       if (suspect) then
-        msg = empm_check_guards(model, k)
-        msg = first_problem(msg, k)
+        msg = empm_check_guards(model, k, inode)
+        msg = first_problem(msg, k, inode)
         if (len(msg) > 0) then
           call restore(); call fail(msg); return
         end if
@@ -430,6 +434,7 @@ contains
       sst%isnap = isnap; sst%steps = st%steps; sst%dt_min = st%dt_min; sst%dt_max = st%dt_max
       sst%t_start = st%t_start; sst%energy_initial = st%energy_initial
       sst%work_gravity = st%work_gravity
+      call empm_share_traction_state(model) ! the root writes every face centre's state
       call hook%checkpoint(model, hist, sst, ec)
       call system_clock(clock_ckpt)
     end subroutine checkpoint
@@ -472,8 +477,10 @@ contains
       type(empm_error_t), intent(out) :: ec
       real(wp) :: before, static, res0
       logical :: moved
-      call empm_rebalance(model, before, static, moved, ec)
+      integer :: migrated
+      call empm_rebalance(model, before, static, moved, migrated, ec)
       if (ec%code /= 0) return
+      st%migrated = st%migrated + migrated
       st%imbalance = max(st%imbalance, before)
       st%imbalance_static = max(st%imbalance_static, static)
       if (.not. moved) return
@@ -482,11 +489,13 @@ contains
       call good%alloc(model%grid%ndim, model%pts%np, model%pts%nstate, ec)
       if (ec%code /= 0) return
       call good%copy_state_from(model%pts)
+      call save_tractions() ! the start-up resets the traction state too
       res0 = model%residual
       call integ%prepare(model, ec)
       if (ec%code /= 0) return
       call model%pts%copy_state_from(good)
       call integ%resync(model)
+      call restore_tractions()
       model%residual = res0
       call particle_scratch(ec)
       model%diag_step = -1 ! the last stress update's screen was of the particles as they were
@@ -535,6 +544,7 @@ contains
       st%tracked = model%track; st%residual = model%residual
       call empm_energies(model, psi, ekin, estr, egrav)
       st%energy_final = ekin + estr + egrav
+      st%halo_bytes = model%comm%max_real(real(model%halo%sent - sent0, wp) / max(st%steps, 1))
       if (present(stats)) stats = st
     end subroutine finish_stats
 
@@ -609,17 +619,24 @@ contains
 
     ! The problem the serial run would report, on every process: the particle with the
     ! smallest id (`id`, huge(1) for a nodal one, which every process finds alike).
-    function first_problem(mine, id) result(text)
+    function first_problem(mine, id, node) result(text)
       character(len=*), intent(in) :: mine
-      integer, intent(in) :: id
+      integer, intent(in) :: id, node
       character(len=:), allocatable :: text
-      integer :: first, lowest
+      integer :: first, lowest, lnode
       text = mine
       if (.not. model%comm%parallel()) return
       lowest = model%comm%min_int(merge(id, huge(1), len(mine) > 0))
-      if (lowest == huge(1) .and. model%comm%min_int(len(mine)) > 0) return ! nodal: alike
-      first = model%comm%min_int(merge(model%comm%rank, model%comm%nranks, &
-                                       len(mine) > 0 .and. id == lowest))
+      if (lowest == huge(1)) then
+        ! Nodal problems only: a node is checked where it is complete (the processes whose
+        ! particles reach it); the lowest node is the serial run's first.
+        lnode = model%comm%min_int(merge(node, huge(1), len(mine) > 0))
+        first = model%comm%min_int(merge(model%comm%rank, model%comm%nranks, &
+                                         len(mine) > 0 .and. node == lnode))
+      else
+        first = model%comm%min_int(merge(model%comm%rank, model%comm%nranks, &
+                                         len(mine) > 0 .and. id == lowest))
+      end if
       if (first == model%comm%nranks) return
       call model%comm%bcast_text(text, first)
     end function first_problem
@@ -813,14 +830,17 @@ contains
   !> Check particle and nodal fields after a step (state variables included: they must stay
   !> finite); returns '' when all is well, otherwise a message naming the step, the particle or
   !> node and the quantity.
-  function empm_check_guards(model, where) result(msg)
+  function empm_check_guards(model, where, node) result(msg)
     type(empm_model_t), intent(in) :: model !! simulation state
     integer, intent(out), optional :: where !! id of the particle it names; huge(1) for a node
                                             !! or no problem
+    integer, intent(out), optional :: node  !! the node it names; huge(1) for a particle or
+                                            !! no problem
     character(len=:), allocatable :: msg    !! '' or the first problem found
     integer :: p, I
     msg = ''
     if (present(where)) where = huge(1)
+    if (present(node)) node = huge(1)
     associate (pts => model%pts)
       do p = 1, pts%np
         if (.not. all(ieee_is_finite(pts%x(:, p)))) then
@@ -866,12 +886,15 @@ contains
       end do
     end associate
     do I = 1, model%nodes%nnode
+      ! A parallel run's nodes are complete only where this process's particles reach.
+      if (.not. model%halo%in_core(model%grid, I)) cycle
       if (.not. all(ieee_is_finite(model%nodes%vel(:, I)))) then
         msg = 'step '//str(model%step)//': non-finite nodal velocity at node '//str(I)
-        return
-      end if
-      if (.not. all(ieee_is_finite(model%nodes%acc(:, I)))) then
+      else if (.not. all(ieee_is_finite(model%nodes%acc(:, I)))) then
         msg = 'step '//str(model%step)//': non-finite nodal acceleration at node '//str(I)
+      end if
+      if (len(msg) > 0) then
+        if (present(node)) node = I
         return
       end if
     end do
@@ -935,6 +958,9 @@ contains
       s = s//'; '//str(st%nranks)//' processes, '//str(st%rebalances)//' re-cuts, particles '// &
         'per process at most '//trim(adjustl(e0))//' x the mean (never re-cut: '// &
         trim(adjustl(e1))//')'
+      write(e0, '(es10.3)') st%halo_bytes
+      s = s//', '//str(st%migrated)//' particles migrated, halo '//trim(adjustl(e0))// &
+        ' bytes per step'
     end if
   end function empm_run_summary
 

@@ -7,14 +7,7 @@
 
 #include "empm.h"
 
-static int failures = 0;
-#define CHECK(cond)                                                             \
-  do {                                                                          \
-    if (!(cond)) {                                                              \
-      fprintf(stderr, "%s:%d: check failed: %s\n", __FILE__, __LINE__, #cond); \
-      failures++;                                                               \
-    }                                                                           \
-  } while (0)
+#include "check.h"
 
 /* A 1D bar of n particles on [0, 10], optionally moving at speed v0. */
 static empm_model *bar(int n, double v0)
@@ -204,6 +197,21 @@ int main(int argc, char **argv)
   CHECK(empm_model_from_case("/nonexistent/case.nml", &c, msg, sizeof msg) != EMPM_OK);
   CHECK(empm_run_case_file(argv[2], NULL, msg, sizeof msg) == EMPM_ERR_INPUT);
   CHECK(empm_run_case_file(NULL, NULL, msg, sizeof msg) == EMPM_ERR_USAGE);
+
+  /* A communicator where MPI cannot serve it (a build without MPI, or MPI not started, as
+   * here): a usage error saying why (the MPI hosts are capi_mpi_c and capi_mpi_f77). */
+  {
+    double origin[1] = {0}, h[1] = {1};
+    int ncell[1] = {4};
+    empm_model *m = NULL;
+    CHECK(empm_model_create(1, origin, h, ncell, &m, msg, sizeof msg) == EMPM_OK);
+    CHECK(empm_model_set_comm(m, 0) == EMPM_ERR_USAGE);
+    CHECK(empm_model_error(m, msg, sizeof msg) == EMPM_OK && strstr(msg, "MPI") != NULL);
+    printf("communicator refused: %s\n", msg);
+    empm_model_destroy(m);
+    CHECK(empm_run_case_file_comm(argv[1], NULL, 0, msg, sizeof msg) == EMPM_ERR_USAGE);
+    CHECK(strstr(msg, "MPI") != NULL);
+  }
 
   empm_model_destroy(a);
   empm_model_destroy(b);

@@ -9,7 +9,11 @@ and the result equals the serial run's to 1e-9 (a plastic flow over 8,600 steps 
 processes' other summation order: measured 1.3e-10; the elastic cases of same_answers.py are
 held to 1e-12).
 
-Usage: balance.py EMPM MPIRUN WORKDIR
+With `--refine K` the grid's cells and the particles' spacing are K times finer (K² times the
+particles, K times the steps): a measurement, not part of CTest. At K = 4 (12,800 particles)
+the bound is the issue's 1.1.
+
+Usage: balance.py EMPM MPIRUN WORKDIR [--refine K]
 """
 import os
 import pathlib
@@ -51,15 +55,18 @@ CASE = """&grid
 
 def main():
     empm, mpirun, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
+    refine = int(sys.argv[sys.argv.index("--refine") + 1]) if "--refine" in sys.argv else 1
     work.mkdir(parents=True, exist_ok=True)
-    (work / "column.nml").write_text(CASE)
+    case = CASE.replace("h = 0.01, cells = 60, 24",
+                        f"h = {0.01 / refine}, cells = {60 * refine}, {24 * refine}")
+    (work / "column.nml").write_text(case)
     mpi = [mpirun, "--oversubscribe"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
     r = subprocess.run([empm, "run", "column.nml", "-o", "serial.h5"], cwd=work,
-                       capture_output=True, text=True, timeout=600)
+                       capture_output=True, text=True, timeout=600 * refine)
     if r.returncode:
         print("FAIL serial run:", r.stderr[-400:]); return 1
     r = subprocess.run(mpi + ["-n", "4", empm, "run", "column.nml", "-o", "p4.h5"], cwd=work,
-                       capture_output=True, text=True, timeout=600)
+                       capture_output=True, text=True, timeout=600 * refine)
     out = r.stdout + r.stderr
     m = re.search(r"(\d+) re-cuts, particles per process at most ([0-9.]+) x the mean "
                   r"\(never re-cut: ([0-9.]+)\)", out)
@@ -69,7 +76,8 @@ def main():
     diff, where, _ = compare(work / "serial.h5", work / "p4.h5")
     print(f"4 processes: {recuts} re-cuts, at most {worst} x the mean (first boxes: {static}); "
           f"against the serial run {diff:.2e} ({where})")
-    ok = recuts > 0 and static >= 2.0 and worst <= 1.25 and diff <= 1e-9
+    bound = 1.1 if refine >= 4 else 1.25
+    ok = recuts > 0 and static >= 2.0 and worst <= bound and diff <= 1e-9
     print("ok" if ok else "FAIL")
     return 0 if ok else 1
 

@@ -131,6 +131,43 @@ CASES = {
   history_every = 20, snapshot_times = {snap}
 /
 """,
+    # 2D: a long strip sliding on a frictional base, on a grid far wider than a process's
+    # region (its nodes plus the margin of docs/parallel.md): each process holds only part of
+    # the nodal sums, so the neighbour exchange, the reactions of the named base (each node
+    # counted by one process) and the free surfaces' extension at the regions' edges are
+    # exercised. A velocity wave along it keeps the nodal values non-uniform. A pressure on
+    # part of its top moves with it across the processes' boxes: its loaded particles (and
+    # their face centres' shape-function state) change process at the re-cuts.
+    "strip2d": """&grid
+  ndim = 2, h = 0.0625, cells = 160, 6
+/
+&material
+  name = 'm', model = 'linear_elastic', E = 1.0e6, nu = 0.25, density = 2000.0
+/
+&particles
+  material = 'm', lo = 0.0, 0.0, hi = 9.0, 0.25, velocity = 1.0, 0.0, geostatic = .true.,
+  k0 = 0.0, velocity_sine_amplitude = 0.3, 0.05, velocity_sine_wavenumber = 1.0, 2.0
+/
+&shape
+  family = '{shape}' {shape_keys}
+/
+&integrator
+  scheme = '{scheme}', t_end = {t_end}
+/
+&loads
+  gravity = 0.0, -10.0
+/
+&boundary
+  name = 'base', lo = 0.0, 0.0, hi = 10.0, 0.0, friction_angle = 10.0, normal = '+y'
+/
+&traction
+  name = 'load', lo = 2.0, 0.22, hi = 4.5, 0.25, face = '+y', pressure = 2.0e4,
+  ramp = 'linear', ramp_time = 0.1
+/
+&output
+  history_every = 20, snapshot_times = {snap}
+/
+""",
     # 2D: a block of a user material (tests/umat/umat_probe.f, which records its arguments in
     # STATEV: NOEL must be the particle's id, the same on any number of processes). The probe
     # keeps the stress at zero: the block moves with its initial (non-uniform) velocity, so the
@@ -162,7 +199,7 @@ CASES = {
 # block stops at 0.57 s).
 TIMES = {"bar1d": (4.0, "1.0, 2.0, 4.0"), "disks2d": (3.0, "1.0, 2.0, 3.0"),
          "block3d": (0.1, "0.05, 0.1"), "slide2d": (0.7, "0.3, 0.7"),
-         "umat2d": (0.05, "0.02, 0.05")}
+         "umat2d": (0.05, "0.02, 0.05"), "strip2d": (0.3, "0.1, 0.3")}
 SCHEMES = ["musl", "usl", "usf", "pc_newmark", "pc_published", "gen_alpha", "gen_alpha_grid"]
 # Frictional walls: not gen_alpha* (refused); usl inverts the block's front particle (docs/input.md).
 SLIDE_SCHEMES = ["musl", "usf", "pc_newmark", "pc_published"]
@@ -239,6 +276,8 @@ def main():
     combos = [c for c in itertools.product(CASES, SCHEMES, SHAPES)
               if c[0] != "slide2d" or (c[2] == "linear" and c[1] in SLIDE_SCHEMES)]
     combos = [c for c in combos if c[0] != "umat2d" or (c[1] == "musl" and c[2] == "linear")]
+    combos = [c for c in combos if c[0] != "strip2d" or
+              (c[2] in ("linear", "lme") and c[1] in SLIDE_SCHEMES)]
     if not lib.exists():
         combos = [c for c in combos if c[0] != "umat2d"]
         env_note.append(f"umat2d skipped: no {lib}")
