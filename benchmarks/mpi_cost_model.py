@@ -3,10 +3,13 @@
 scaling to 1,024 processes of a 3D LME case with 1e8 particles, for the block-local design
 (each process its box of cells plus ghost node layers, shared nodes summed with its 26
 neighbours), from a measured per-particle cost and the network figures of a typical cluster.
-It models the design the docs describe as the next stage, not today's replicated grid (whose
-whole-grid sums the last columns show for comparison).
+It models the block-local design the docs describe as the next stage; the last two columns
+compare today's design (the nodal sums exchanged with the neighbours over regions widened by the
+margin of docs/parallel.md, but every process's per-node passes over the whole grid, measured
+at 25 ns a node-step in 3D: `--node-pass-ns`) and the all-reduce of whole nodal arrays before it.
 
 Usage: mpi_cost_model.py [--alpha-us 1.5] [--gbytes 12.5] [--node 0.78] [--imbalance 1.05]
+       [--node-pass-ns 25]
   --alpha-us  message latency [us]; --gbytes link bandwidth [GB/s] (InfiniBand HDR100-class)
   --node      a process's speed when every core of its node is busy, over its speed alone:
               measured 0.78 for the 2D linear step (benchmarks/mpi_scaling.py, 2 processes on
@@ -31,6 +34,11 @@ ALPHA = opt("--alpha-us", 1.5) * 1e-6       # s per message
 BETA = 1.0 / (opt("--gbytes", 12.5) * 1e9)  # s per byte
 NODE = opt("--node", 0.78)                  # on-node speed factor with every core busy
 IMB = opt("--imbalance", 1.05)              # largest process's share over the mean
+# Today's per-node passes (zeroing, divisions, constraints, the search for nearly-empty nodes,
+# the nodal screen) over the whole grid, per node and step of pc_newmark: 3D, one process, a
+# 100^3-cell grid holding 8 particles (1.28 s for 49 steps; 2D: 16 ns).
+NODE_PASS = opt("--node-pass-ns", 25.0) * 1e-9
+REACH = 0                                   # the family's reach in cells (set in main())
 COST, W = 7.0e-6, 3                         # set per table in main()
 PPC = 8                                     # particles per cell (2 per direction)
 ROW = 8 * (10 * 3 + 4 + 12 + 9 + 3 + 2)     # bytes of a migrating particle (pack_rows, 2 state)
@@ -42,7 +50,8 @@ SUMS = (5, 3)
 
 
 def step_time(n_particles, procs):
-    """(compute, halo, migration, reductions, replicated-grid sums) in seconds a step."""
+    """(compute, halo, migration, reductions, replicated-grid sums, today's extra) in seconds
+    a step."""
     n = n_particles / procs
     cells = n / PPC
     m = cells ** (1.0 / 3.0)                 # cells a side of a cubic block
@@ -64,32 +73,43 @@ def step_time(n_particles, procs):
         # Today's design: every nodal array summed in full (ring allreduce: 2 (P-1)/P of it).
         replicated = sum(2 * (procs - 1) / procs * nodes_all * d * 8 * BETA
                          + 2 * math.ceil(math.log2(procs)) * ALPHA for d in SUMS)
-    return compute, halo, migration, reductions, replicated
+    # Today: the neighbours' regions overlap 2 (margin + reach + 1) layers deep (margin =
+    # 8 + 2 (reach + 1)), and every process passes over every node.
+    today = nodes_all * NODE_PASS
+    if procs > 1:
+        depth = 2 * (8 + 2 * (REACH + 1) + REACH + 1)
+        shared = 6 * (m + 1) ** 2 * depth + 12 * (m + 1) * depth ** 2 + 8 * depth ** 3
+        for doubles in SUMS:
+            today += 26 * ALPHA + 2 * shared * doubles * 8 * BETA
+    return compute, halo, migration, reductions, replicated, today
 
 
 def table(title, rows):
     print(title)
     print(f"{'P':>5} {'particles/P':>12} {'step [ms]':>10} {'compute':>8} {'halo':>8} "
-          f"{'migr.':>7} {'reduce':>7} {'eff.':>6} {'eff. (replicated grid)':>23}")
+          f"{'migr.':>7} {'reduce':>7} {'eff.':>6} {'eff. today':>11} {'eff. all-reduce':>16}")
     for procs, n_total, t1 in rows:
-        c, h, mg, r, rep = step_time(n_total, procs)
+        c, h, mg, r, rep, tod = step_time(n_total, procs)
         t = c + h + mg + r
         eff = t1 / t if t1 else c / t
-        trep = c + rep + r
+        trep = c + rep + r + (n_total / PPC) * NODE_PASS
         eff_rep = t1 / trep if t1 else c / trep
+        ttod = c + tod + mg + r
+        eff_tod = t1 / ttod if t1 else c / ttod
         print(f"{procs:5d} {n_total / procs:12.3g} {1e3 * t:10.3f} {c / t:8.1%} {h / t:8.1%} "
-              f"{mg / t:7.1%} {r / t:7.1%} {eff:6.2f} {eff_rep:23.2f}")
+              f"{mg / t:7.1%} {r / t:7.1%} {eff:6.2f} {eff_tod:11.2f} {eff_rep:16.2f}")
     print()
 
 
 def main():
-    global COST, W
+    global COST, W, REACH
     print(f"latency {ALPHA * 1e6:.1f} us, {1 / BETA / 1e9:.1f} GB/s; on-node factor {NODE}; "
           f"imbalance {IMB}; {PPC} particles per cell\n")
     procs = [1, 2, 8, 64, 128, 256, 512, 1024]
     for label, cost, width in [("3D LME gamma = 3 (7.0 us a particle-step)", 7.0e-6, 3),
                                ("3D linear (0.25 us a particle-step)", 0.254e-6, 1)]:
         COST, W = cost, width
+        REACH = 3 if width == 3 else 0  # LME gamma = 3: ceil(R/h) = 3; linear: 0
         big = 1.0e8
         t_one = step_time(big, 1)[0]
         table(f"{label}: strong scaling, 1e8 particles (efficiency = T1 / (P T_P))",

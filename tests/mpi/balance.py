@@ -11,7 +11,10 @@ held to 1e-12).
 
 With `--refine K` the grid's cells and the particles' spacing are K times finer (K² times the
 particles, K times the steps): a measurement, not part of CTest. At K = 4 (12,800 particles)
-the bound is the issue's 1.1.
+the bound is the issue's 1.1, and the serial run is reported, not asserted: over 52,000 steps
+of plastic flow the two summation orders part (measured: 52,493 against 52,701 steps, runout
+0.4801 against 0.4806 m), as they did before the neighbour exchange (that build's 4 processes
+agree with today's to 3.3e-15).
 
 Usage: balance.py EMPM MPIRUN WORKDIR [--refine K]
 """
@@ -77,7 +80,7 @@ def main():
     print(f"4 processes: {recuts} re-cuts, at most {worst} x the mean (first boxes: {static}); "
           f"against the serial run {diff:.2e} ({where})")
     bound = 1.1 if refine >= 4 else 1.25
-    ok = recuts > 0 and static >= 2.0 and worst <= bound and diff <= 1e-9
+    ok = recuts > 0 and static >= 2.0 and worst <= bound and (refine > 1 or diff <= 1e-9)
     print("ok" if ok else "FAIL")
     return 0 if ok else 1
 
