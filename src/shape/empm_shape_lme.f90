@@ -116,6 +116,7 @@ module empm_shape_lme
   real(wp), parameter :: LME_REMEDY_FACTOR = 0.5_wp !! γ multiplier per retry
   real(wp), parameter :: LME_TOL_CONV = 1.0e-10_wp  !! convergence: ‖r‖/h below this
   real(wp), parameter :: LME_TOL_GUARD = 1.0e-4_wp  !! Armijo backtracking while ‖r‖/h above this
+  real(wp), parameter :: LME_ARMIJO_C = 1.0e-4_wp   !! Armijo sufficient-decrease constant
   real(wp), parameter :: LME_COND_MAX = 1.0e12_wp   !! largest accepted Frobenius condition of J
   real(wp), parameter :: LME_J_MIN = 1.0e-14_wp     !! smallest accepted ‖J‖_F (units of h²)
   real(wp), parameter :: LME_STEP_MAX = 10.0_wp     !! largest Newton step |Δλ|·h

@@ -157,7 +157,9 @@ contains
       real(wp) :: s1, s2, rd1, rd2, xi1, xi2, q, f, fmax, qmax, x2max, xlo1, xhi1, xlo2, xhi2
       real(wp) :: l1, l2, c1, c2, sw, m1(2), m2(3), m3(4), logz, r(2), jm(3), ji(3), scl, rn
       real(wp) :: d1, d2, dn2, b1, b2, mm(4), det, q1, q2, t1(2), t2(3), st, rt1, rt2, p, v1, v2
+      real(wp) :: slope, logz0
       integer :: lo1, hi1, lo2, hi2, i, j, id0, a, amax, it
+      logical :: guard, far
       nn = 0
       it = 0
       ! LME_FALLBACK until the very end: every early return hands over to the general path.
@@ -200,22 +202,30 @@ contains
       if (.not. (xhi1 >= 0.0_wp .and. xlo1 <= 0.0_wp .and. xhi2 >= 0.0_wp .and. &
                  xlo2 <= 0.0_wp)) return
       x2max = qmax / gamma
+      far = .false.
       c1 = dN(1, amax); c2 = dN(2, amax)
       call weights_2d(nn, fmax, c1, c2, dN, N, sw, m1, m2, m3, logz, r, jm)
       do
-        ! Newton step Δ = −J⁻¹r, full steps only (‖r‖ small).
+        ! Newton step Δ = −J⁻¹r, full steps only.
         rn = sqrt(r(1)**2 + r(2)**2)
         if (logz < -qmax - 1.0e-9_wp * (1.0_wp + qmax)) return
-        if (rn > LME_TOL_GUARD) return
         call inverse_2d(jm, ji, scl)
         if (scl < LME_J_MIN) return
         d1 = -(ji(1) * r(1) + ji(2) * r(2)) / scl
         d2 = -(ji(2) * r(1) + ji(3) * r(2)) / scl
         dn2 = d1**2 + d2**2
-        ! Done when r(λ+Δ), bounded by ½ (ξmax + ‖r‖)³ |Δ|², is within the tolerance.
-        if (rn < LME_TOL_CONV .or. &
-            0.5_wp * (sqrt(x2max) + rn)**3 * dn2 < LME_TOL_CONV) exit
+        ! Done when r(λ+Δ), bounded by ½ (ξmax + ‖r‖)³ |Δ|², is within the tolerance; after a
+        ! far start (a step under the Armijo test) only on ‖r‖ itself, as the general path,
+        ! whose result (p* to O(1e-20)) a far start then reproduces to round-off.
+        if (rn < LME_TOL_CONV) exit
+        if (.not. far .and. 0.5_wp * (sqrt(x2max) + rn)**3 * dn2 < LME_TOL_CONV) exit
         if (it >= maxit .or. dn2 > LME_STEP_MAX**2) return
+        ! Far from λ* the general path takes the full step only when it decreases log Z enough
+        ! (Armijo, its first trial): the same test below on the new weights, else hand over.
+        guard = rn > LME_TOL_GUARD
+        if (guard) then
+          slope = r(1) * d1 + r(2) * d2; logz0 = logz; far = .true.
+        end if
         l1 = l1 + d1; l2 = l2 + d2
         it = it + 1
         if (.not. (abs(l1) <= LME_LAM_MAX .and. abs(l2) <= LME_LAM_MAX)) return
@@ -229,6 +239,9 @@ contains
         end do
         c1 = dN(1, amax); c2 = dN(2, amax)
         call weights_2d(nn, fmax, c1, c2, dN, N, sw, m1, m2, m3, logz, r, jm)
+        if (guard) then
+          if (.not. (logz <= logz0 + LME_ARMIJO_C * slope)) return
+        end if
       end do
       ! Final values p̂_a ∝ w_a (1 + q·u_a), u = ξ − c, the linearised step with q chosen so that
       ! Σ p̂ ξ = 0 holds exactly (not only to first order): Σ w (1 + q·u) ξ = 0, i.e.
@@ -267,7 +280,11 @@ contains
         dN(1, a) = -p * (ji(1) * v1 + ji(2) * v2) / h
         dN(2, a) = -p * (ji(2) * v1 + ji(3) * v2) / h
       end do
-      lam(1) = (l1 + d1) / h; lam(2) = (l2 + d2) / h
+      if (far) then
+        lam(1) = l1 / h; lam(2) = l2 / h ! the general path's λ: its last iterate
+      else
+        lam(1) = (l1 + d1) / h; lam(2) = (l2 + d2) / h
+      end if
       iters = it
 
     end subroutine lme_point_2d

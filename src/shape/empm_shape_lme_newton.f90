@@ -8,8 +8,8 @@ submodule (empm_shape_lme) empm_shape_lme_newton
                         SHAPE_OUTSIDE_HULL, SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES
   implicit none
 
-  !> Armijo sufficient-decrease constant and smallest step fraction.
-  real(wp), parameter :: ARMIJO_C = 1.0e-4_wp, ARMIJO_TMIN = 1.0e-12_wp
+  !> Smallest Armijo step fraction (the constant is LME_ARMIJO_C, shared with the 2D batch path).
+  real(wp), parameter :: ARMIJO_TMIN = 1.0e-12_wp
   !> Most candidates for the direct hull test on failure (C(40, 4) = 91390 simplices in 3D).
   integer, parameter :: HULL_TEST_MAXN = 40
   !> Largest Frobenius condition of the candidates' covariance before they count as flat.
@@ -260,7 +260,7 @@ contains
           do
             lt = lh + t * del
             call moments(nd, nc, gamma, N, dN, lt, logzt, rt, jt, cent, gnode, node)
-            if (logzt <= logz + ARMIJO_C * t * slope) exit
+            if (logzt <= logz + LME_ARMIJO_C * t * slope) exit
             t = 0.5_wp * t
             if (t < ARMIJO_TMIN) then
               info = SHAPE_NOT_CONVERGED; exit main
