@@ -133,12 +133,13 @@ contains
   ! ---- Fortran-level operations (shared by the C and Fortran 77 entry points) ------------------
 
   !> Run a case file as `empm run` does (quiet), writing its output (or `output` if not blank).
-  integer function capi_run_case(path, output, msg) result(rc)
+  integer function capi_run_case(path, output, msg, comm) result(rc)
     character(len=*), intent(in) :: path                 !! case file
     character(len=*), intent(in) :: output               !! output override, '' for the case's
     character(len=:), allocatable, intent(out) :: msg    !! error text, '' on success
+    type(empm_comm_t), intent(in), optional :: comm      !! the processes (default: this one)
     type(empm_error_t) :: e
-    call empm_run_case(path, output=output, progress=.false., err=e)
+    call empm_run_case(path, output=output, progress=.false., err=e, comm=comm)
     rc = e%code
     msg = ''
     if (e%code /= EMPM_OK .and. allocated(e%message)) msg = e%message
@@ -152,7 +153,6 @@ contains
     character(len=*), intent(in) :: output               !! output override, '' for the case's
     integer, intent(in) :: handle                        !! the host's communicator
     character(len=:), allocatable, intent(out) :: msg    !! error text, '' on success
-    type(empm_error_t) :: e
     type(empm_comm_t) :: comm
     integer :: info
     call empm_comm_from_handle(handle, comm, info)
@@ -161,11 +161,8 @@ contains
       msg = 'empm_run_case_file_comm: '//empm_comm_handle_problem(info)
       return
     end if
-    call empm_run_case(path, output=output, progress=.false., err=e, comm=comm)
+    rc = capi_run_case(path, output, msg, comm)
     call comm%finish()
-    rc = e%code
-    msg = ''
-    if (e%code /= EMPM_OK .and. allocated(e%message)) msg = e%message
   end function capi_run_case_comm
 
   !> Run a programmatic model on the processes of a host's communicator (its Fortran handle;

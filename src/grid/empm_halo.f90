@@ -51,8 +51,6 @@ module empm_halo
     real(wp), allocatable :: rbuf(:)       !! receive buffer (3 size(list))
     integer, allocatable :: got(:,:)       !! every process's boxes as gathered (12, nranks)
     integer(int64) :: sent = 0             !! bytes sent by `sum` so far
-    integer :: sums = 0                    !! sums done so far
-    integer :: rebuilds = 0                !! plans built so far
   contains
     procedure :: update => halo_update
     procedure :: set_boxes => halo_set_boxes
@@ -134,7 +132,6 @@ contains
     integer, intent(in) :: nranks
     integer :: q, k, n, e, u, nlist, o(3, 2)
     integer, allocatable :: tag(:), fill(:)
-    self%rebuilds = self%rebuilds + 1
     ! Neighbours and the sizes of their overlaps.
     if (allocated(self%nbr)) deallocate(self%nbr, self%ptr)
     allocate(self%nbr(nranks), self%ptr(nranks + 1))
@@ -286,7 +283,6 @@ contains
     call self%pack(m, a)
     call comm%swap(self%nbr(1:self%nnbr), self%ptr(1:self%nnbr + 1), m, self%sbuf, self%rbuf)
     self%sent = self%sent + 8_int64 * m * size(self%list)
-    self%sums = self%sums + 1
     call self%merge(m, a)
   end subroutine exchange
 

@@ -491,11 +491,12 @@ contains
         end associate
         fext2 = model%comm%sum_real(fext2)
         funb = sqrt(model%comm%sum_real(funb))
-      else if (model%loads%ntraction() > 0) then
-        fext2 = ext_norm2(model%nodes%mass, g(1:d), self%tforce)
-        funb = sqrt(sum(model%nodes%force**2))
       else
-        fext2 = sum(model%nodes%mass**2) * sum(g(1:d)**2)
+        if (model%loads%ntraction() > 0) then
+          fext2 = ext_norm2(model%nodes%mass, g(1:d), self%tforce)
+        else
+          fext2 = sum(model%nodes%mass**2) * sum(g(1:d)**2)
+        end if
         funb = sqrt(sum(model%nodes%force**2))
       end if
       if (fext2 > 0.0_wp) then

@@ -100,9 +100,9 @@ contains
   !> process of its box (each process's particles then in id order). `before` and `static`
   !> report the largest process's share over the mean: in the boxes being replaced, and in the
   !> first ones (what a split never re-cut would hold). `moved` is false when no particle
-  !> changed process (the new boxes are kept), and with surface tractions (their particle lists
-  !> stay as they are, and so do the boxes). `migrated` counts the particles that changed
-  !> process (all processes together). Serial: nothing changes.
+  !> changed process (the new boxes are kept). Surface tractions follow their particles
+  !> ([[empm_share_traction_state]], then their entries found again by id). `migrated` counts
+  !> the particles that changed process (all processes together). Serial: nothing changes.
   subroutine empm_rebalance(model, before, static, moved, migrated, err)
     type(empm_model_t), intent(inout) :: model          !! model (shared among processes)
     real(wp), intent(out) :: before                     !! max/mean in the boxes replaced
@@ -172,8 +172,9 @@ contains
   end subroutine empm_rebalance
 
   !> Every process gets the tractions' shape-function state (λ at each face centre, which
-  !> only the process holding the particle updates): before the particles move to other
-  !> processes, and before the root writes a checkpoint. Collective; serial: nothing.
+  !> only the process holding the particle updates, as `part` still says): after the
+  !> particles moved, before their entries are found again, and before the root writes a
+  !> checkpoint. Collective; serial: nothing.
   subroutine empm_share_traction_state(model)
     type(empm_model_t), intent(inout) :: model !! model (shared among processes)
     integer :: k, j

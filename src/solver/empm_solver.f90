@@ -618,25 +618,24 @@ contains
     end subroutine progress
 
     ! The problem the serial run would report, on every process: the particle with the
-    ! smallest id (`id`, huge(1) for a nodal one, which every process finds alike).
+    ! smallest id (`id`, huge(1) for a nodal problem); with none, the node with the smallest
+    ! number (`node`: a node is checked only where it is complete, on the processes whose
+    ! particles reach it, so the processes may find different ones).
     function first_problem(mine, id, node) result(text)
       character(len=*), intent(in) :: mine
       integer, intent(in) :: id, node
       character(len=:), allocatable :: text
-      integer :: first, lowest, lnode
+      integer :: first, lowest, key
       text = mine
       if (.not. model%comm%parallel()) return
-      lowest = model%comm%min_int(merge(id, huge(1), len(mine) > 0))
+      key = id
+      lowest = model%comm%min_int(merge(key, huge(1), len(mine) > 0))
       if (lowest == huge(1)) then
-        ! Nodal problems only: a node is checked where it is complete (the processes whose
-        ! particles reach it); the lowest node is the serial run's first.
-        lnode = model%comm%min_int(merge(node, huge(1), len(mine) > 0))
-        first = model%comm%min_int(merge(model%comm%rank, model%comm%nranks, &
-                                         len(mine) > 0 .and. node == lnode))
-      else
-        first = model%comm%min_int(merge(model%comm%rank, model%comm%nranks, &
-                                         len(mine) > 0 .and. id == lowest))
+        key = node
+        lowest = model%comm%min_int(merge(key, huge(1), len(mine) > 0))
       end if
+      first = model%comm%min_int(merge(model%comm%rank, model%comm%nranks, &
+                                       len(mine) > 0 .and. key == lowest))
       if (first == model%comm%nranks) return
       call model%comm%bcast_text(text, first)
     end function first_problem
