@@ -32,6 +32,7 @@ module empm_capi
   use empm_driver, only: empm_run_case, empm_agree_error
   use empm_comm, only: empm_comm_t, empm_comm_from_handle, empm_comm_handle_problem
   use empm_partition, only: empm_partition_particles, empm_gather_particles
+  use empm_h5_mpio, only: empm_h5_collective
   implicit none
   private
   public :: empm_capi_box_t
@@ -707,7 +708,8 @@ contains
     meta%shape = b%shape_name; meta%integrator = b%scheme_name
     meta%cfl = b%run%cfl; meta%t_end = b%model%t
     if (b%model%comm%parallel()) then
-      ! The root gathers every particle into a copy (the model goes on with its share).
+      ! Copies (the model goes on with its share): blocks of ids written together (parallel
+      ! HDF5), or every particle gathered on the root.
       call write_gathered()
     else
       call empm_write_results(trim(path), b%model, b%hist, meta, .true., '', e)
@@ -717,11 +719,14 @@ contains
     subroutine write_gathered()
       type(empm_model_t), allocatable :: whole
       type(empm_history_t), allocatable :: hall
+      logical :: together
       allocate(whole, source=b%model)
       allocate(hall, source=b%hist)
-      call empm_gather_particles(whole, hall, e)
-      if (e%code == EMPM_OK .and. whole%comm%is_root()) &
-        call empm_write_results(trim(path), whole, hall, meta, .true., '', e)
+      together = empm_h5_collective(b%model%comm)
+      call empm_gather_particles(whole, hall, e, blocks=together)
+      if (together) call empm_agree_error(b%model%comm, e)
+      if (e%code == EMPM_OK .and. (together .or. whole%comm%is_root())) &
+        call empm_write_results(trim(path), whole, hall, meta, .true., '', e, together)
       call empm_agree_error(b%model%comm, e)
     end subroutine write_gathered
   end function capi_write

@@ -11,7 +11,7 @@
 !> error saying why, a file that is not an empm checkpoint, one written by another version, for
 !> another case file (first differing line named) or for another particle set.
 module empm_checkpoint
-  use hdf5, only: hid_t, h5open_f, h5fcreate_f, h5fclose_f, H5F_ACC_EXCL_F, h5eset_auto_f
+  use hdf5, only: hid_t, h5open_f, h5eset_auto_f
   use empm_kinds, only: wp
   use empm_strings, only: str
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO, EMPM_ERR_INPUT
@@ -25,7 +25,7 @@ module empm_checkpoint
   use empm_model, only: empm_model_t
   use empm_history, only: empm_history_t
   use empm_solver, only: empm_solver_state_t
-  use empm_output, only: empm_partial_name
+  use empm_output, only: empm_shared_file_t
   implicit none
   private
   public :: empm_checkpoint_write, empm_checkpoint_read, empm_checkpoint_path
@@ -55,8 +55,10 @@ contains
   end function empm_checkpoint_path
 
   !> Write a checkpoint of `model`, `hist` and `state` to `path`, atomically; an existing
-  !> `path` becomes the previous checkpoint (`prev`), replacing the one before.
-  subroutine empm_checkpoint_write(path, prev, model, hist, state, case_text, err)
+  !> `path` becomes the previous checkpoint (`prev`), replacing the one before. `together`:
+  !> called by all processes, each holding a block of consecutive ids, as
+  !> [[empm_write_results]]; the error is the root's.
+  subroutine empm_checkpoint_write(path, prev, model, hist, state, case_text, err, together)
     character(len=*), intent(in) :: path               !! checkpoint file
     character(len=*), intent(in) :: prev               !! where the previous one goes
     type(empm_model_t), intent(in) :: model            !! the state after a completed step
@@ -64,50 +66,57 @@ contains
     type(empm_solver_state_t), intent(in) :: state     !! the time loop's progress
     character(len=*), intent(in) :: case_text          !! full text of the case file
     type(empm_error_t), intent(out) :: err             !! error (EMPM_ERR_IO), if any
+    logical, intent(in), optional :: together          !! all processes write it (blocks)
     integer(hid_t) :: fid, g, gs, gk
     character(len=:), allocatable :: tmp
     integer :: e, ierr, k, n, nd, oserr, info
-    tmp = empm_partial_name(path)
+    type(empm_shared_file_t) :: sf
+    n = model%pts%np
     call h5open_f(e)
     call h5eset_auto_f(0, e)
-    call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e)
+    call sf%create(path, model%comm, n, together, tmp, fid, e)
     if (e /= 0) then
+      if (.not. sf%root) return
       call empm_raise(EMPM_ERR_IO, path//': cannot create the checkpoint '//tmp//': '// &
         empm_errno_text(empm_errno()), err); return
     end if
     ierr = 0
-    n = model%pts%np; nd = model%grid%ndim
+    nd = model%grid%ndim
     call h5_attr(fid, 'format', FORMAT_NAME, ierr)
     call h5_attr(fid, 'format_version', FORMAT_VERSION, ierr)
     call h5_attr(fid, 'empm_version', empm_version(), ierr)
     call h5_attr(fid, 'case_text', case_text, ierr)
     call h5_attr(fid, 'threads', empm_max_threads(), ierr)
-    call h5_attr(fid, 'particles', n, ierr)
+    call h5_attr(fid, 'particles', sf%ntotal, ierr)
     call h5_attr(fid, 'ndim', nd, ierr)
     call h5_attr(fid, 'nstate', model%pts%nstate, ierr)
 
     call h5_group(fid, 'model', g, ierr)
-    call h5_write(g, 'scalars', [model%t, real(model%step, wp), model%residual], ierr)
+    call h5_write(g, 'scalars', [model%t, real(model%step, wp), model%residual], ierr, sf%sh)
     call h5_close_group(g, ierr)
 
     call h5_group(fid, 'particles', g, ierr)
     associate (p => model%pts)
-      call h5_write(g, 'x', p%x(:, 1:n), ierr); call h5_write(g, 'x0', p%x0(:, 1:n), ierr)
-      call h5_write(g, 'v', p%v(:, 1:n), ierr); call h5_write(g, 'a', p%a(:, 1:n), ierr)
-      call h5_write(g, 'dx', p%dx(:, 1:n), ierr)
-      call h5_write(g, 'm', p%m(1:n), ierr); call h5_write(g, 'vol', p%vol(1:n), ierr)
-      call h5_write(g, 'vol0', p%vol0(1:n), ierr); call h5_write(g, 'rho', p%rho(1:n), ierr)
-      call h5_write(g, 'stress', p%stress(:, 1:n), ierr)
-      call h5_write(g, 'strain', p%strain(:, 1:n), ierr)
-      call h5_write(g, 'F', reshape(p%F(:, :, 1:n), [9, n]), ierr)
-      call h5_write(g, 'lp', p%lp(:, 1:n), ierr)
-      call h5_write(g, 'lam', p%lam(:, 1:n), ierr)
-      call h5_write(g, 'lam_old', p%lam_old(:, 1:n), ierr)
-      call h5_write(g, 'lam_prev', p%lam_prev(:, 1:n), ierr)
-      call h5_write(g, 'lam_old_prev', p%lam_old_prev(:, 1:n), ierr)
-      call h5_write(g, 'vol_fill', p%vol_fill(1:n), ierr)
-      call h5_write(g, 'mat', real(p%mat(1:n), wp), ierr)
-      if (p%nstate > 0) call h5_write(g, 'state', p%state(:, 1:n), ierr)
+      call h5_write(g, 'x', p%x(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'x0', p%x0(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'v', p%v(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'a', p%a(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'dx', p%dx(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'm', p%m(1:n), ierr, sf%pp)
+      call h5_write(g, 'vol', p%vol(1:n), ierr, sf%pp)
+      call h5_write(g, 'vol0', p%vol0(1:n), ierr, sf%pp)
+      call h5_write(g, 'rho', p%rho(1:n), ierr, sf%pp)
+      call h5_write(g, 'stress', p%stress(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'strain', p%strain(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'F', reshape(p%F(:, :, 1:n), [9, n]), ierr, sf%pp)
+      call h5_write(g, 'lp', p%lp(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'lam', p%lam(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'lam_old', p%lam_old(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'lam_prev', p%lam_prev(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'lam_old_prev', p%lam_old_prev(:, 1:n), ierr, sf%pp)
+      call h5_write(g, 'vol_fill', p%vol_fill(1:n), ierr, sf%pp)
+      call h5_write(g, 'mat', real(p%mat(1:n), wp), ierr, sf%pp)
+      if (p%nstate > 0) call h5_write(g, 'state', p%state(:, 1:n), ierr, sf%pp)
     end associate
     call h5_close_group(g, ierr)
 
@@ -117,7 +126,7 @@ contains
         call h5_group(g, str(k), gk, ierr)
         associate (tr => model%loads%tractions(k))
           if (allocated(tr%lam)) then
-            if (size(tr%lam) > 0) call h5_write(gk, 'lam', tr%lam, ierr)
+            if (size(tr%lam) > 0) call h5_write(gk, 'lam', tr%lam, ierr, sf%sh)
           end if
         end associate
         call h5_close_group(gk, ierr)
@@ -127,32 +136,33 @@ contains
 
     call h5_group(fid, 'solver', g, ierr)
     call h5_write(g, 'scalars', [real(state%isnap, wp), real(state%steps, wp), state%dt_min, &
-      state%dt_max, state%t_start, state%energy_initial, state%work_gravity], ierr)
+      state%dt_max, state%t_start, state%energy_initial, state%work_gravity], ierr, sf%sh)
     call h5_close_group(g, ierr)
 
     call h5_group(fid, 'history', g, ierr)
     call h5_write(g, 'counts', [real(hist%nt, wp), real(hist%nprobe, wp), &
-      real(hist%nsnap, wp), merge(1.0_wp, 0.0_wp, hist%tracked), real(hist%nset, wp)], ierr)
+      real(hist%nsnap, wp), merge(1.0_wp, 0.0_wp, hist%tracked), real(hist%nset, wp)], ierr, &
+      sf%sh)
     if (hist%nt > 0) then
-      call h5_write(g, 't', hist%t(1:hist%nt), ierr)
-      call h5_write(g, 'kinetic', hist%kinetic(1:hist%nt), ierr)
-      call h5_write(g, 'strain', hist%strain(1:hist%nt), ierr)
-      call h5_write(g, 'gravity', hist%gravity(1:hist%nt), ierr)
+      call h5_write(g, 't', hist%t(1:hist%nt), ierr, sf%sh)
+      call h5_write(g, 'kinetic', hist%kinetic(1:hist%nt), ierr, sf%sh)
+      call h5_write(g, 'strain', hist%strain(1:hist%nt), ierr, sf%sh)
+      call h5_write(g, 'gravity', hist%gravity(1:hist%nt), ierr, sf%sh)
       if (hist%nprobe > 0) then
         call h5_write(g, 'px', reshape(hist%px(:, :, 1:hist%nt), &
-          [size(hist%px, 1) * hist%nprobe, hist%nt]), ierr)
+          [size(hist%px, 1) * hist%nprobe, hist%nt]), ierr, sf%sh)
         call h5_write(g, 'pv', reshape(hist%pv(:, :, 1:hist%nt), &
-          [size(hist%pv, 1) * hist%nprobe, hist%nt]), ierr)
+          [size(hist%pv, 1) * hist%nprobe, hist%nt]), ierr, sf%sh)
         call h5_write(g, 'ps', reshape(hist%ps(:, :, 1:hist%nt), [6 * hist%nprobe, hist%nt]), &
-          ierr)
+          ierr, sf%sh)
       end if
       if (hist%tracked) then
-        call h5_write(g, 'residual', hist%residual(1:hist%nt), ierr)
+        call h5_write(g, 'residual', hist%residual(1:hist%nt), ierr, sf%sh)
         if (hist%nset > 0) then
           call h5_write(g, 'reaction', reshape(hist%reaction(:, :, 1:hist%nt), &
-            [size(hist%reaction, 1) * hist%nset, hist%nt]), ierr)
+            [size(hist%reaction, 1) * hist%nset, hist%nt]), ierr, sf%sh)
           call h5_write(g, 'set_disp', reshape(hist%set_disp(:, :, 1:hist%nt), &
-            [size(hist%set_disp, 1) * hist%nset, hist%nt]), ierr)
+            [size(hist%set_disp, 1) * hist%nset, hist%nt]), ierr, sf%sh)
         end if
       end if
     end if
@@ -160,25 +170,23 @@ contains
     do k = 1, hist%nsnap
       call h5_group(gs, str(k), gk, ierr)
       associate (sn => hist%snap(k))
-        call h5_write(gk, 'scalars', [sn%t, real(sn%step, wp)], ierr)
-        call h5_write(gk, 'x', sn%x, ierr); call h5_write(gk, 'v', sn%v, ierr)
-        call h5_write(gk, 'stress', sn%stress, ierr); call h5_write(gk, 'strain', sn%strain, ierr)
-        call h5_write(gk, 'm', sn%m, ierr); call h5_write(gk, 'vol', sn%vol, ierr)
-        call h5_write(gk, 'rho', sn%rho, ierr)
-        if (size(sn%state) > 0) call h5_write(gk, 'state', sn%state, ierr)
+        call h5_write(gk, 'scalars', [sn%t, real(sn%step, wp)], ierr, sf%sh)
+        call h5_write(gk, 'x', sn%x, ierr, sf%pp)
+        call h5_write(gk, 'v', sn%v, ierr, sf%pp)
+        call h5_write(gk, 'stress', sn%stress, ierr, sf%pp)
+        call h5_write(gk, 'strain', sn%strain, ierr, sf%pp)
+        call h5_write(gk, 'm', sn%m, ierr, sf%pp)
+        call h5_write(gk, 'vol', sn%vol, ierr, sf%pp)
+        call h5_write(gk, 'rho', sn%rho, ierr, sf%pp)
+        if (model%pts%nstate > 0) call h5_write(gk, 'state', sn%state, ierr, sf%pp)
       end associate
       call h5_close_group(gk, ierr)
     end do
     call h5_close_group(gs, ierr)
     call h5_close_group(g, ierr)
 
-    oserr = 0
-    if (ierr /= 0) oserr = empm_errno()
-    call h5fclose_f(fid, e)
-    if (e /= 0) then
-      ierr = e
-      if (oserr == 0) oserr = empm_errno()
-    end if
+    call sf%close(model%comm, fid, ierr, oserr)
+    if (.not. sf%root) return
     if (ierr /= 0) then
       info = empm_remove(tmp)
       call empm_raise(EMPM_ERR_IO, path//': writing the checkpoint failed: '// &

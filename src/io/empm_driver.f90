@@ -19,6 +19,7 @@ module empm_driver
   use empm_kinds, only: wp
   use empm_comm, only: empm_comm_t
   use empm_partition, only: empm_partition_particles, empm_gather_particles
+  use empm_h5_mpio, only: empm_h5_collective
   implicit none
   private
   public :: empm_run_case, empm_agree_error
@@ -44,17 +45,22 @@ contains
     type(empm_error_t), intent(out) :: err
     type(empm_model_t) :: whole
     type(empm_history_t) :: hwhole
+    logical :: together
     if (.not. model%comm%parallel()) then
       call empm_checkpoint_write(self%path, self%prev, model, hist, state, self%case_text, err)
       return
     end if
-    ! Several processes: the root writes one checkpoint with every particle in id order (as
-    ! a serial run's), from copies, so that the run goes on with its own share; any number of
-    ! processes can restart from it.
+    ! Several processes: one checkpoint with every particle in id order (as a serial run's),
+    ! from copies, so that the run goes on with its own share; any number of processes can
+    ! restart from it. Written by all together, each a block of ids (parallel HDF5), or by the
+    ! root holding every particle.
+    together = empm_h5_collective(model%comm)
     whole = model; hwhole = hist
-    call empm_gather_particles(whole, hwhole, err)
-    if (err%code == EMPM_OK .and. model%comm%is_root()) &
-      call empm_checkpoint_write(self%path, self%prev, whole, hwhole, state, self%case_text, err)
+    call empm_gather_particles(whole, hwhole, err, blocks=together)
+    if (together) call empm_agree_error(model%comm, err)
+    if (err%code == EMPM_OK .and. (together .or. model%comm%is_root())) &
+      call empm_checkpoint_write(self%path, self%prev, whole, hwhole, state, self%case_text, err, &
+      together)
     call empm_agree_error(model%comm, err)
   end subroutine hook_checkpoint
 
@@ -130,7 +136,7 @@ contains
     type(driver_hook_t) :: hook
     type(empm_solver_state_t) :: sst
     character(len=:), allocatable :: warning
-    logical :: resumed
+    logical :: resumed, together
     type(empm_history_t) :: hist
     type(empm_error_t) :: e, ew
     type(empm_output_meta_t) :: meta
@@ -206,13 +212,17 @@ contains
     meta%case_file = path; meta%case_text = cs%text
     meta%shape = cs%shape_name; meta%integrator = cs%scheme_name
     meta%cfl = cs%run%cfl; meta%t_end = cs%run%t_end
-    ! Several processes: the root gathers the particles and writes as a serial run would.
-    call empm_gather_particles(cs%model, hist, ew)
-    if (ew%code == EMPM_OK .and. cs%model%comm%is_root()) then
+    ! Several processes: each gets a block of consecutive ids and they write the file
+    ! together (parallel HDF5), or the root gets every particle and writes as a serial run.
+    together = empm_h5_collective(cs%model%comm)
+    call empm_gather_particles(cs%model, hist, ew, blocks=together)
+    if (together) call empm_agree_error(cs%model%comm, ew)
+    if (ew%code == EMPM_OK .and. (together .or. cs%model%comm%is_root())) then
       if (e%code == EMPM_OK) then
-        call empm_write_results(cs%output_file, cs%model, hist, meta, .true., '', ew)
+        call empm_write_results(cs%output_file, cs%model, hist, meta, .true., '', ew, together)
       else
-        call empm_write_results(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
+        call empm_write_results(cs%output_file, cs%model, hist, meta, .false., e%message, ew, &
+          together)
       end if
     end if
     call empm_agree_error(cs%model%comm, ew)

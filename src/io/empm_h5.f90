@@ -8,14 +8,30 @@ module empm_h5
     H5T_NATIVE_DOUBLE, H5T_NATIVE_INTEGER, H5T_NATIVE_CHARACTER, H5S_SCALAR_F, &
     h5open_f, h5fopen_f, h5fclose_f, h5fis_hdf5_f, H5F_ACC_RDONLY_F, h5lexists_f, h5dopen_f, &
     h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5dread_f, &
-    h5aopen_f, h5aget_type_f, h5tget_size_f, h5aread_f, h5aexists_f
+    h5aopen_f, h5aget_type_f, h5tget_size_f, h5aread_f, h5aexists_f, h5sselect_hyperslab_f, &
+    h5sselect_none_f, H5S_SELECT_SET_F, H5P_DEFAULT_F
   use empm_kinds, only: wp
   implicit none
   private
   public :: hid_t, h5_group, h5_close_group, h5_write, h5_attr
   public :: h5_open_read, h5_close_file, h5_exists, h5_dims, h5_read, h5_read_attr
+  public :: h5_part_t
 
-  !> Write a dataset (real rank 1–2, integer rank 1).
+  !> This process's part of a dataset that several processes write together into one file
+  !> (parallel HDF5, the file opened by all): every process creates the dataset, with the
+  !> same shape, and writes its part. A dataset of particles: `total` columns (the last
+  !> extent), this process's from column `first` (0-based) on. A dataset every process holds
+  !> whole (histories, probes): `total` < 0, and the processes whose `writes` is false select
+  !> nothing.
+  type :: h5_part_t
+    integer(hsize_t) :: first = 0          !! columns of the processes before this one
+    integer(hsize_t) :: total = -1         !! the dataset's columns; < 0: the array's own
+    logical :: writes = .true.             !! this process writes its array
+    integer(hid_t) :: xfer = 0             !! data transfer properties (0: HDF5's default)
+  end type h5_part_t
+
+  !> Write a dataset (real rank 1–2, integer rank 1); with `part`, this process's part of it
+  !> ([[h5_part_t]]).
   interface h5_write
     module procedure write_r1, write_r2, write_i1
   end interface h5_write
@@ -57,59 +73,104 @@ contains
     if (e /= 0) ierr = e
   end subroutine h5_close_group
 
-  subroutine write_r1(loc, name, a, ierr)
+  subroutine write_r1(loc, name, a, ierr, part)
     integer(hid_t), intent(in) :: loc
     character(len=*), intent(in) :: name
     real(wp), intent(in) :: a(:)
     integer, intent(inout) :: ierr
+    type(h5_part_t), intent(in), optional :: part
     integer(hsize_t) :: dims(1)
-    integer(hid_t) :: sid, did
-    integer :: e(4)
+    integer(hid_t) :: fsid, msid, did, xfer
+    integer :: e(5)
     real(wp), allocatable :: buf(:)
     dims = shape(a, kind=hsize_t)
     buf = a  ! contiguous copy for the C library (a may be a strided section)
-    call h5screate_simple_f(1, dims, sid, e(1))
-    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, sid, did, e(2))
-    call h5dwrite_f(did, H5T_NATIVE_DOUBLE, buf, dims, e(3))
-    call h5dclose_f(did, e(4)); call h5sclose_f(sid, e(1))
+    call spaces(dims, part, fsid, msid, xfer, e(1))
+    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, fsid, did, e(2))
+    call h5dwrite_f(did, H5T_NATIVE_DOUBLE, buf, dims, e(3), msid, fsid, xfer)
+    call h5dclose_f(did, e(4)); call close_spaces(fsid, msid, e(5))
     if (any(e /= 0)) ierr = 1
   end subroutine write_r1
 
-  subroutine write_r2(loc, name, a, ierr)
+  subroutine write_r2(loc, name, a, ierr, part)
     integer(hid_t), intent(in) :: loc
     character(len=*), intent(in) :: name
     real(wp), intent(in) :: a(:,:)
     integer, intent(inout) :: ierr
+    type(h5_part_t), intent(in), optional :: part
     integer(hsize_t) :: dims(2)
-    integer(hid_t) :: sid, did
-    integer :: e(4)
+    integer(hid_t) :: fsid, msid, did, xfer
+    integer :: e(5)
     real(wp), allocatable :: buf(:, :)
     dims = shape(a, kind=hsize_t)
     buf = a  ! contiguous copy for the C library (a may be a strided section)
-    call h5screate_simple_f(2, dims, sid, e(1))
-    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, sid, did, e(2))
-    call h5dwrite_f(did, H5T_NATIVE_DOUBLE, buf, dims, e(3))
-    call h5dclose_f(did, e(4)); call h5sclose_f(sid, e(1))
+    call spaces(dims, part, fsid, msid, xfer, e(1))
+    call h5dcreate_f(loc, name, H5T_NATIVE_DOUBLE, fsid, did, e(2))
+    call h5dwrite_f(did, H5T_NATIVE_DOUBLE, buf, dims, e(3), msid, fsid, xfer)
+    call h5dclose_f(did, e(4)); call close_spaces(fsid, msid, e(5))
     if (any(e /= 0)) ierr = 1
   end subroutine write_r2
 
-  subroutine write_i1(loc, name, a, ierr)
+  subroutine write_i1(loc, name, a, ierr, part)
     integer(hid_t), intent(in) :: loc
     character(len=*), intent(in) :: name
     integer, intent(in) :: a(:)
     integer, intent(inout) :: ierr
+    type(h5_part_t), intent(in), optional :: part
     integer(hsize_t) :: dims(1)
-    integer(hid_t) :: sid, did
-    integer :: e(4)
+    integer(hid_t) :: fsid, msid, did, xfer
+    integer :: e(5)
     integer, allocatable :: buf(:)
     dims = shape(a, kind=hsize_t)
     buf = a  ! contiguous copy for the C library (a may be a strided section)
-    call h5screate_simple_f(1, dims, sid, e(1))
-    call h5dcreate_f(loc, name, H5T_NATIVE_INTEGER, sid, did, e(2))
-    call h5dwrite_f(did, H5T_NATIVE_INTEGER, buf, dims, e(3))
-    call h5dclose_f(did, e(4)); call h5sclose_f(sid, e(1))
+    call spaces(dims, part, fsid, msid, xfer, e(1))
+    call h5dcreate_f(loc, name, H5T_NATIVE_INTEGER, fsid, did, e(2))
+    call h5dwrite_f(did, H5T_NATIVE_INTEGER, buf, dims, e(3), msid, fsid, xfer)
+    call h5dclose_f(did, e(4)); call close_spaces(fsid, msid, e(5))
     if (any(e /= 0)) ierr = 1
   end subroutine write_i1
+
+  ! The dataset's file space and the buffer's memory space (`dims`, the buffer's shape) with
+  ! their selections. Without `part`: both the buffer's shape, all of it written. With `part`:
+  ! the file space's last extent is part%total (or the buffer's when part%total < 0) and the
+  ! buffer goes to the columns from part%first on, or nothing is selected when part%writes is
+  ! false or the buffer is empty (the process still takes part in the collective calls).
+  subroutine spaces(dims, part, fsid, msid, xfer, e)
+    integer(hsize_t), intent(in) :: dims(:)
+    type(h5_part_t), intent(in), optional :: part
+    integer(hid_t), intent(out) :: fsid, msid, xfer
+    integer, intent(out) :: e
+    integer(hsize_t) :: fdims(size(dims)), start(size(dims))
+    integer :: r, k(5)
+    r = size(dims)
+    k = 0
+    xfer = H5P_DEFAULT_F
+    call h5screate_simple_f(r, dims, msid, k(1))
+    if (.not. present(part)) then
+      call h5screate_simple_f(r, dims, fsid, k(2))
+      e = maxval(abs(k)); return
+    end if
+    if (part%xfer /= 0) xfer = part%xfer
+    fdims = dims
+    if (part%total >= 0) fdims(r) = part%total
+    call h5screate_simple_f(r, fdims, fsid, k(2))
+    if (part%writes .and. product(dims) > 0) then
+      start = 0
+      if (part%total >= 0) start(r) = part%first
+      call h5sselect_hyperslab_f(fsid, H5S_SELECT_SET_F, start, dims, k(3))
+    else
+      call h5sselect_none_f(fsid, k(3)); call h5sselect_none_f(msid, k(4))
+    end if
+    e = maxval(abs(k))
+  end subroutine spaces
+
+  subroutine close_spaces(fsid, msid, e)
+    integer(hid_t), intent(in) :: fsid, msid
+    integer, intent(out) :: e
+    integer :: k(2)
+    call h5sclose_f(fsid, k(1)); call h5sclose_f(msid, k(2))
+    e = maxval(abs(k))
+  end subroutine close_spaces
 
   subroutine attr_r0(loc, name, x, ierr)
     integer(hid_t), intent(in) :: loc

@@ -26,20 +26,40 @@ module empm_output
   use hdf5, only: h5open_f, h5fcreate_f, h5fclose_f, H5F_ACC_EXCL_F, h5eset_auto_f, &
     h5dont_atexit_f
   use empm_kinds, only: wp
-  use empm_h5, only: hid_t, h5_group, h5_close_group, h5_write, h5_attr
+  use empm_h5, only: hid_t, h5_group, h5_close_group, h5_write, h5_attr, h5_part_t
+  use empm_h5_mpio, only: empm_h5_collective, h5_mpio_properties, h5_mpio_close
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO, EMPM_ERR_INPUT
   use empm_files, only: empm_rename, empm_remove
   use empm_posix, only: empm_getpid, empm_process_alive, empm_path_kind, empm_errno, &
     empm_errno_text, empm_write_reason, PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY
   use empm_version_info, only: empm_version
   use empm_model, only: empm_model_t
+  use empm_comm, only: empm_comm_t
   use empm_material, only: STATE_NAME_LEN
   use empm_history, only: empm_history_t
   use empm_particles, only: empm_particles_t
   implicit none
   private
   public :: empm_write_results, empm_output_meta_t, empm_xdmf_path
-  public :: empm_output_claim, empm_output_release, empm_partial_name
+  public :: empm_output_claim, empm_output_release, empm_partial_name, empm_shared_file_t
+
+  !> An HDF5 file written by the processes of a run: together (parallel HDF5, each process
+  !> holding a block of consecutive particle ids, [[empm_h5_collective]]) or by one process.
+  !> `create` opens it under a partial name (the root's, the same for all), `close` closes it
+  !> and gives every process the worst outcome; then the root alone renames it.
+  type :: empm_shared_file_t
+    logical :: together = .false.  !! the processes write it together
+    logical :: root = .true.       !! this process writes what is not per particle, renames
+    integer :: first = 0           !! particles of the processes before this one
+    integer :: ntotal = 0          !! particles in the file
+    type(h5_part_t) :: pp          !! this process's part of a particle dataset
+    type(h5_part_t) :: sh          !! its part of any other dataset (the root's array)
+    integer(hid_t) :: fapl = 0     !! file access properties (MPI-IO), 0: none
+    integer(hid_t) :: xfer = 0     !! data transfer properties (collective), 0: none
+  contains
+    procedure :: create => shared_create
+    procedure :: close => shared_close
+  end type empm_shared_file_t
 
   !> Descriptive metadata stored as root attributes.
   type :: empm_output_meta_t
@@ -54,21 +74,31 @@ module empm_output
 contains
 
   !> Write `model` (final state) and `hist` to `path` (+ `path` with .xmf), atomically.
-  subroutine empm_write_results(path, model, hist, meta, complete, status, err)
+  !>
+  !> `together` (several processes with parallel HDF5: [[empm_h5_collective]]): called by
+  !> every process, each holding a block of consecutive ids in id order, and the snapshots'
+  !> rows of those ids (`empm_gather_particles(..., blocks=.true.)`); they open one file and
+  !> write each its columns of every particle dataset, the root alone the rest, the XDMF file
+  !> and the rename. An error is returned on the root (the callers agree on it). Otherwise one
+  !> process calls it, holding every particle.
+  subroutine empm_write_results(path, model, hist, meta, complete, status, err, together)
     character(len=*), intent(in) :: path               !! output HDF5 file
-    type(empm_model_t), intent(in) :: model            !! state to store as /final
-    type(empm_history_t), intent(in) :: hist           !! histories and snapshots
+    type(empm_model_t), intent(in) :: model            !! state to store as /final (this
+                                                       !! process's block when collective)
+    type(empm_history_t), intent(in) :: hist           !! histories and snapshots (likewise)
     type(empm_output_meta_t), intent(in) :: meta       !! root attributes
     logical, intent(in) :: complete                    !! whether the run reached t_end
     character(len=*), intent(in) :: status             !! '' or the message that stopped it
     type(empm_error_t), intent(out), optional :: err   !! error, if present
+    logical, intent(in), optional :: together          !! all processes write it (blocks)
     integer(hid_t) :: fid, g, gs, gp
-    integer :: ierr, e, k, info, n, oserr
+    integer :: ierr, e, k, info, n, oserr, np
     character(len=:), allocatable :: tmp, xmf, xtmp
     character(len=16) :: sname
     character(len=STATE_NAME_LEN), allocatable :: snames(:)
     integer, allocatable :: scol(:,:)
-    tmp = empm_partial_name(path)
+    type(empm_shared_file_t) :: sf
+    np = model%pts%np
     ierr = 0
     call state_columns(model, snames, scol)
     ! A file whose close failed (its flush: disk full) stays open inside HDF5, and closing it
@@ -78,8 +108,9 @@ contains
     call h5open_f(e)
     ! Failures are reported once, by us, with the system's reason: not HDF5's error stacks.
     call h5eset_auto_f(0, e)
-    call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e)
+    call sf%create(path, model%comm, np, together, tmp, fid, e)
     if (e /= 0) then
+      if (.not. sf%root) return
       oserr = empm_errno()
       call empm_raise(EMPM_ERR_IO, path//': cannot create HDF5 file '//tmp//': '// &
         empm_errno_text(oserr), err); return
@@ -101,29 +132,29 @@ contains
     call h5_attr(fid, 'time', model%t, ierr)
     call h5_attr(fid, 'steps', model%step, ierr)
     call h5_attr(fid, 'mpi_ranks', model%comm%nranks, ierr)
+    call h5_attr(fid, 'writers', merge(model%comm%nranks, 1, sf%together), ierr)
 
     call h5_group(fid, 'grid', g, ierr)
     call h5_attr(g, 'origin', model%grid%origin(1:model%grid%ndim), ierr)
     call h5_attr(g, 'h', model%grid%h(1:model%grid%ndim), ierr)
     call h5_attr(g, 'cells', model%grid%ncell(1), ierr)
-    call h5_write(g, 'cells_per_direction', model%grid%ncell(1:model%grid%ndim), ierr)
+    call h5_write(g, 'cells_per_direction', model%grid%ncell(1:model%grid%ndim), ierr, sf%sh)
     call h5_close_group(g, ierr)
 
     call h5_group(fid, 'final', g, ierr)
     call h5_attr(g, 'time', model%t, ierr)
     call h5_attr(g, 'step', model%step, ierr)
-    call write_state(g, model%pts, ierr)
-    call write_state_vars(g, model%pts%state(:, 1:model%pts%np), model%pts%mat(1:model%pts%np), &
-      snames, scol, ierr)
-    call write_xdmf_fields(g, model%pts%x(:, 1:model%pts%np), model%pts%x0(:, 1:model%pts%np), &
-      model%pts%v(:, 1:model%pts%np), model%pts%stress(:, 1:model%pts%np), &
-      model%pts%strain(:, 1:model%pts%np), ierr)
+    call write_state(g, model%pts, sf%pp, ierr)
+    call write_state_vars(g, model%pts%state(:, 1:np), model%pts%mat(1:np), snames, scol, sf%pp, &
+      ierr)
+    call write_xdmf_fields(g, model%pts%x(:, 1:np), model%pts%x0(:, 1:np), model%pts%v(:, 1:np), &
+      model%pts%stress(:, 1:np), model%pts%strain(:, 1:np), sf%pp, ierr)
     call h5_close_group(g, ierr)
 
     ! Polyvertex connectivity (0-based), shared by every frame: without it ParaView's XDMF
     ! reader builds no cells and its default view is empty.
     call h5_group(fid, 'xdmf', g, ierr)
-    call h5_write(g, 'vertices', [(k - 1, k = 1, model%pts%np)], ierr)
+    call h5_write(g, 'vertices', [(sf%first + k - 1, k = 1, np)], ierr, sf%pp)
     call h5_close_group(g, ierr)
 
     call h5_group(fid, 'snapshots', gs, ierr)
@@ -132,38 +163,39 @@ contains
       call h5_group(gs, trim(sname), g, ierr)
       call h5_attr(g, 'time', hist%snap(k)%t, ierr)
       call h5_attr(g, 'step', hist%snap(k)%step, ierr)
-      call h5_write(g, 'x', hist%snap(k)%x, ierr)
-      call h5_write(g, 'xyz', pad3(hist%snap(k)%x), ierr)
-      call h5_write(g, 'v', hist%snap(k)%v, ierr)
-      call h5_write(g, 'stress', hist%snap(k)%stress, ierr)
-      call h5_write(g, 'strain', hist%snap(k)%strain, ierr)
-      call h5_write(g, 'mass', hist%snap(k)%m, ierr)
-      call h5_write(g, 'volume', hist%snap(k)%vol, ierr)
-      call h5_write(g, 'density', hist%snap(k)%rho, ierr)
+      call h5_write(g, 'x', hist%snap(k)%x, ierr, sf%pp)
+      call h5_write(g, 'xyz', pad3(hist%snap(k)%x), ierr, sf%pp)
+      call h5_write(g, 'v', hist%snap(k)%v, ierr, sf%pp)
+      call h5_write(g, 'stress', hist%snap(k)%stress, ierr, sf%pp)
+      call h5_write(g, 'strain', hist%snap(k)%strain, ierr, sf%pp)
+      call h5_write(g, 'mass', hist%snap(k)%m, ierr, sf%pp)
+      call h5_write(g, 'volume', hist%snap(k)%vol, ierr, sf%pp)
+      call h5_write(g, 'density', hist%snap(k)%rho, ierr, sf%pp)
       ! Particles keep their material for the whole run: the current indices apply.
-      n = min(size(hist%snap(k)%m), model%pts%np)
+      n = min(size(hist%snap(k)%m), np)
       if (allocated(hist%snap(k)%state)) call write_state_vars(g, hist%snap(k)%state(:, 1:n), &
-        model%pts%mat(1:n), snames, scol, ierr)
+        model%pts%mat(1:n), snames, scol, sf%pp, ierr)
       call write_xdmf_fields(g, hist%snap(k)%x(:, 1:n), model%pts%x0(:, 1:n), &
-        hist%snap(k)%v(:, 1:n), hist%snap(k)%stress(:, 1:n), hist%snap(k)%strain(:, 1:n), ierr)
+        hist%snap(k)%v(:, 1:n), hist%snap(k)%stress(:, 1:n), hist%snap(k)%strain(:, 1:n), sf%pp, &
+        ierr)
       call h5_close_group(g, ierr)
     end do
     call h5_close_group(gs, ierr)
 
     call h5_group(fid, 'history', g, ierr)
-    call h5_write(g, 'time', hist%t(1:hist%nt), ierr)
-    call h5_write(g, 'kinetic_energy', hist%kinetic(1:hist%nt), ierr)
-    call h5_write(g, 'strain_energy', hist%strain(1:hist%nt), ierr)
-    call h5_write(g, 'gravity_potential', hist%gravity(1:hist%nt), ierr)
+    call h5_write(g, 'time', hist%t(1:hist%nt), ierr, sf%sh)
+    call h5_write(g, 'kinetic_energy', hist%kinetic(1:hist%nt), ierr, sf%sh)
+    call h5_write(g, 'strain_energy', hist%strain(1:hist%nt), ierr, sf%sh)
+    call h5_write(g, 'gravity_potential', hist%gravity(1:hist%nt), ierr, sf%sh)
     if (hist%tracked) then
       ! Residual and reactions (docs/output.md), recorded when the model tracks them.
-      call h5_write(g, 'residual', hist%residual(1:hist%nt), ierr)
+      call h5_write(g, 'residual', hist%residual(1:hist%nt), ierr, sf%sh)
       if (hist%nset > 0) then
         call h5_group(g, 'reaction', gs, ierr)
         do k = 1, hist%nset
           call h5_group(gs, trim(hist%set_name(k)), gp, ierr)
-          call h5_write(gp, 'force', hist%reaction(:, k, 1:hist%nt), ierr)
-          call h5_write(gp, 'displacement', hist%set_disp(:, k, 1:hist%nt), ierr)
+          call h5_write(gp, 'force', hist%reaction(:, k, 1:hist%nt), ierr, sf%sh)
+          call h5_write(gp, 'displacement', hist%set_disp(:, k, 1:hist%nt), ierr, sf%sh)
           call h5_close_group(gp, ierr)
         end do
         call h5_close_group(gs, ierr)
@@ -175,24 +207,18 @@ contains
     do k = 1, hist%nprobe
       call h5_group(gs, trim(hist%probe_name(k)), gp, ierr)
       call h5_attr(gp, 'particle', hist%probe_particle(k), ierr)
-      call h5_write(gp, 'time', hist%t(1:hist%nt), ierr)
-      call h5_write(gp, 'x', hist%px(:, k, 1:hist%nt), ierr)
-      call h5_write(gp, 'v', hist%pv(:, k, 1:hist%nt), ierr)
-      call h5_write(gp, 'stress', hist%ps(:, k, 1:hist%nt), ierr)
+      call h5_write(gp, 'time', hist%t(1:hist%nt), ierr, sf%sh)
+      call h5_write(gp, 'x', hist%px(:, k, 1:hist%nt), ierr, sf%sh)
+      call h5_write(gp, 'v', hist%pv(:, k, 1:hist%nt), ierr, sf%sh)
+      call h5_write(gp, 'stress', hist%ps(:, k, 1:hist%nt), ierr, sf%sh)
       call h5_close_group(gp, ierr)
     end do
     call h5_close_group(gs, ierr)
 
-    ! errno now is the reason of a failed write (HDF5 keeps it); a failed close sets it too.
     ! Every group, dataset and attribute is closed by now (the helpers close what they open
     ! even on failure): only the file is left.
-    oserr = 0
-    if (ierr /= 0) oserr = empm_errno()
-    call h5fclose_f(fid, e)
-    if (e /= 0) then
-      if (oserr == 0) oserr = empm_errno()
-      ierr = e
-    end if
+    call sf%close(model%comm, fid, ierr, oserr)
+    if (.not. sf%root) return
     if (ierr /= 0) then
       info = empm_remove(tmp)
       call empm_raise(EMPM_ERR_IO, path//': writing the HDF5 output '//tmp//' failed: '// &
@@ -200,7 +226,7 @@ contains
     end if
     xmf = empm_xdmf_path(path)
     xtmp = empm_partial_name(xmf)
-    call write_xdmf(xtmp, basename(path), model, hist, snames, ierr, oserr)
+    call write_xdmf(xtmp, basename(path), model, hist, sf%ntotal, snames, ierr, oserr)
     if (ierr /= 0) then
       info = empm_remove(tmp); info = empm_remove(xtmp)
       call empm_raise(EMPM_ERR_IO, path//': cannot write the XDMF file '//xtmp//': '// &
@@ -221,23 +247,93 @@ contains
     end if
   end subroutine empm_write_results
 
-  subroutine write_state(g, pts, ierr)
+  !> Create `path`'s partial file (name in `tmp`) for this process's `np` particles, with every
+  !> process of `comm` when they write together (`together` and [[empm_h5_collective]]; the
+  !> caller shared the particles out in blocks of ids). e ≠ 0 on every process when it failed.
+  subroutine shared_create(self, path, comm, np, together, tmp, fid, e)
+    class(empm_shared_file_t), intent(inout) :: self        !! the file's writers
+    character(len=*), intent(in) :: path                    !! final name
+    type(empm_comm_t), intent(in) :: comm                   !! the run's processes
+    integer, intent(in) :: np                               !! this process's particles
+    logical, intent(in), optional :: together               !! all processes write it
+    character(len=:), allocatable, intent(out) :: tmp       !! partial name (the root's)
+    integer(hid_t), intent(out) :: fid                      !! the open file
+    integer, intent(out) :: e                               !! 0 on success
+    integer :: counts(1, comm%nranks)
+    self%together = .false.
+    if (present(together)) self%together = together .and. empm_h5_collective(comm)
+    self%root = comm%is_root() .or. .not. self%together
+    self%first = 0; self%ntotal = np
+    if (self%together) then
+      ! One name for all, the root's; each process's columns follow the lower ranks'.
+      if (comm%is_root()) tmp = empm_partial_name(path)
+      call comm%bcast_text(tmp, 0)
+      call comm%allgather_ints([np], counts)
+      self%first = sum(counts(1, 1:comm%rank)); self%ntotal = sum(counts)
+    else
+      tmp = empm_partial_name(path)
+    end if
+    fid = 0; e = 0
+    ! Collective (it duplicates the communicator): only when all processes are here.
+    if (self%together) call h5_mpio_properties(comm, self%fapl, self%xfer, e)
+    if (e == 0) then
+      if (self%together) then
+        call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e, access_prp=self%fapl)
+      else
+        call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e)
+      end if
+    end if
+    if (self%together) e = comm%max_int(abs(e))
+    ! Particle datasets: this process's columns of ntotal. Others: the root's array.
+    self%pp = h5_part_t(first=self%first, total=merge(self%ntotal, -1, self%together), &
+      writes=.true., xfer=self%xfer)
+    self%sh = h5_part_t(first=0, total=-1, writes=self%root, xfer=self%xfer)
+    if (e /= 0) call h5_mpio_close(self%fapl, self%xfer)
+  end subroutine shared_create
+
+  !> Close the file; ierr (in: this process's write failures) and oserr (the system's reason)
+  !> become the worst over the processes.
+  subroutine shared_close(self, comm, fid, ierr, oserr)
+    class(empm_shared_file_t), intent(inout) :: self !! the file's writers
+    type(empm_comm_t), intent(in) :: comm            !! the processes it was created with
+    integer(hid_t), intent(in) :: fid                !! the open file
+    integer, intent(inout) :: ierr                   !! ≠ 0: a write failed
+    integer, intent(out) :: oserr                    !! errno of the failure, 0 if none
+    integer :: e
+    ! errno now is the reason of a failed write (HDF5 keeps it); a failed close sets it too.
+    oserr = 0
+    if (ierr /= 0) oserr = empm_errno()
+    call h5fclose_f(fid, e)
+    call h5_mpio_close(self%fapl, self%xfer)
+    self%fapl = 0; self%xfer = 0
+    if (e /= 0) then
+      if (oserr == 0) oserr = empm_errno()
+      ierr = e
+    end if
+    if (self%together) then
+      ierr = comm%max_int(abs(ierr))
+      oserr = comm%max_int(oserr)
+    end if
+  end subroutine shared_close
+
+  subroutine write_state(g, pts, pp, ierr)
     integer(hid_t), intent(in) :: g
     type(empm_particles_t), intent(in) :: pts
+    type(h5_part_t), intent(in) :: pp
     integer, intent(inout) :: ierr
     integer :: n
     n = pts%np
-    call h5_write(g, 'x', pts%x(:, 1:n), ierr)
-    call h5_write(g, 'xyz', pad3(pts%x(:, 1:n)), ierr)
-    call h5_write(g, 'x0', pts%x0(:, 1:n), ierr)
-    call h5_write(g, 'v', pts%v(:, 1:n), ierr)
-    call h5_write(g, 'a', pts%a(:, 1:n), ierr)
-    call h5_write(g, 'stress', pts%stress(:, 1:n), ierr)
-    call h5_write(g, 'strain', pts%strain(:, 1:n), ierr)
-    call h5_write(g, 'mass', pts%m(1:n), ierr)
-    call h5_write(g, 'volume', pts%vol(1:n), ierr)
-    call h5_write(g, 'density', pts%rho(1:n), ierr)
-    call h5_write(g, 'material', pts%mat(1:n), ierr)
+    call h5_write(g, 'x', pts%x(:, 1:n), ierr, pp)
+    call h5_write(g, 'xyz', pad3(pts%x(:, 1:n)), ierr, pp)
+    call h5_write(g, 'x0', pts%x0(:, 1:n), ierr, pp)
+    call h5_write(g, 'v', pts%v(:, 1:n), ierr, pp)
+    call h5_write(g, 'a', pts%a(:, 1:n), ierr, pp)
+    call h5_write(g, 'stress', pts%stress(:, 1:n), ierr, pp)
+    call h5_write(g, 'strain', pts%strain(:, 1:n), ierr, pp)
+    call h5_write(g, 'mass', pts%m(1:n), ierr, pp)
+    call h5_write(g, 'volume', pts%vol(1:n), ierr, pp)
+    call h5_write(g, 'density', pts%rho(1:n), ierr, pp)
+    call h5_write(g, 'material', pts%mat(1:n), ierr, pp)
   end subroutine write_state
 
   !> The temporary name a file is written under before it is renamed to `path`: unique to
@@ -369,12 +465,13 @@ contains
 
   !> Group `state` under `g`: one dataset (np) per name, NaN where the particle's material does
   !> not declare the name. Nothing when no material has state variables.
-  subroutine write_state_vars(g, state, mat, names, col, ierr)
+  subroutine write_state_vars(g, state, mat, names, col, pp, ierr)
     integer(hid_t), intent(in) :: g
     real(wp), intent(in) :: state(:,:)
     integer, intent(in) :: mat(:)
     character(len=*), intent(in) :: names(:)
     integer, intent(in) :: col(:,:)
+    type(h5_part_t), intent(in) :: pp
     integer, intent(inout) :: ierr
     integer(hid_t) :: gs
     real(wp), allocatable :: buf(:)
@@ -394,7 +491,7 @@ contains
           buf(p) = nan
         end if
       end do
-      call h5_write(gs, trim(names(k)), buf, ierr)
+      call h5_write(gs, trim(names(k)), buf, ierr, pp)
     end do
     call h5_close_group(gs, ierr)
   end subroutine write_state_vars
@@ -438,28 +535,30 @@ contains
 
   ! Subgroup `xdmf` of a frame group: displacement x − x0 and velocity padded to 3 components,
   ! stress and strain as full tensors (xx, xy, xz, yx, yy, yz, zx, zy, zz).
-  subroutine write_xdmf_fields(g, x, x0, v, stress, strain, ierr)
+  subroutine write_xdmf_fields(g, x, x0, v, stress, strain, pp, ierr)
     integer(hid_t), intent(in) :: g
     real(wp), intent(in) :: x(:,:), x0(:,:), v(:,:), stress(:,:), strain(:,:)
+    type(h5_part_t), intent(in) :: pp
     integer, intent(inout) :: ierr
     integer, parameter :: FULL(9) = [1, 6, 5, 6, 2, 4, 5, 4, 3] ! Voigt row of each entry
     integer(hid_t) :: gx
     call h5_group(g, 'xdmf', gx, ierr)
-    call h5_write(gx, 'displacement', pad3(x - x0), ierr)
-    call h5_write(gx, 'velocity', pad3(v), ierr)
-    call h5_write(gx, 'stress', stress(FULL, :), ierr)
-    call h5_write(gx, 'strain', strain(FULL, :), ierr)
+    call h5_write(gx, 'displacement', pad3(x - x0), ierr, pp)
+    call h5_write(gx, 'velocity', pad3(v), ierr, pp)
+    call h5_write(gx, 'stress', stress(FULL, :), ierr, pp)
+    call h5_write(gx, 'strain', strain(FULL, :), ierr, pp)
     call h5_close_group(gx, ierr)
   end subroutine write_xdmf_fields
 
   !> XDMF 2 temporal collection, one polyvertex grid per snapshot and the final state (unless
   !> the last snapshot is it), written to `xmf` (the caller renames it) with every write
   !> checked; `ierr` /= 0 on failure. `h5name` is the HDF5 file relative to the XDMF's folder.
-  subroutine write_xdmf(xmf, h5name, model, hist, snames, ierr, oserr)
+  subroutine write_xdmf(xmf, h5name, model, hist, ntotal, snames, ierr, oserr)
     character(len=*), intent(in) :: xmf
     character(len=*), intent(in) :: h5name
     type(empm_model_t), intent(in) :: model
     type(empm_history_t), intent(in) :: hist
+    integer, intent(in) :: ntotal ! particles in the file
     character(len=*), intent(in) :: snames(:)
     integer, intent(inout) :: ierr
     integer, intent(out) :: oserr
@@ -472,12 +571,11 @@ contains
       '  <Grid Name="particles" GridType="Collection" CollectionType="Temporal">'//NL
     do k = 1, hist%nsnap
       write(sname, '(i6.6)') k - 1
-      call grid_entry(hist%snap(k)%t, min(size(hist%snap(k)%m), model%pts%np), &
-        '/snapshots/'//trim(sname))
+      call grid_entry(hist%snap(k)%t, ntotal, '/snapshots/'//trim(sname))
     end do
     final_frame = hist%nsnap == 0
     if (.not. final_frame) final_frame = hist%snap(hist%nsnap)%step /= model%step
-    if (final_frame) call grid_entry(model%t, model%pts%np, '/final')
+    if (final_frame) call grid_entry(model%t, ntotal, '/final')
     doc = doc//'  </Grid>'//NL//' </Domain>'//NL//'</Xdmf>'
     oserr = 0
     ! status 'new': created exclusively (the name is this writer's own).

@@ -2,6 +2,7 @@
 !> each process keeps the particles of its box of cells, the boxes cut from the particle
 !> counts by recursive coordinate bisection; the grid stays whole on every process.
 module empm_partition
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, empm_raise_error
   use empm_model, only: empm_model_t
@@ -285,29 +286,51 @@ contains
 
   !> After a parallel run: the root process gets every particle, in id (generation) order,
   !> and every snapshot likewise, to write the results as a serial run would; the other
-  !> processes keep theirs. Serial: nothing changes.
-  subroutine empm_gather_particles(model, hist, err)
+  !> processes keep theirs. With `blocks`, each process gets instead a contiguous block of ids
+  !> (process r: ids ⌊rN/P⌋ + 1 .. ⌊(r + 1)N/P⌋ of N on P processes), in id order, and every
+  !> snapshot's rows of those ids: the processes then write one file together, each its block
+  !> (empm_write_results), and no process holds more than its share. Serial: nothing changes.
+  !> The particles are for output only afterwards: the run cannot go on with them.
+  subroutine empm_gather_particles(model, hist, err, blocks)
     type(empm_model_t), intent(inout) :: model          !! model (its particles replaced on the
-                                                        !! root)
+                                                        !! root, or by the block)
     type(empm_history_t), intent(inout) :: hist         !! record (its snapshots likewise)
     type(empm_error_t), intent(inout), optional :: err  !! allocation failure, if present
+    logical, intent(in), optional :: blocks             !! each process a block of ids
     real(wp), allocatable :: rows(:,:), all(:,:), sorted(:,:)
+    integer, allocatable :: dest(:)
     type(empm_error_t) :: e
-    integer :: m, np, k, nd, ns, oid
+    integer :: m, np, k, nd, ns, oid, first, last, ntotal
+    logical :: by_block
     if (.not. model%comm%parallel()) return
+    by_block = .false.
+    if (present(blocks)) by_block = blocks
     np = model%pts%np; nd = model%grid%ndim; ns = model%pts%nstate
+    ntotal = model%comm%sum_int(np)
+    ! This process's ids: all (the root), none (another process) or its block.
+    first = 1; last = ntotal
+    if (by_block) then
+      first = block_start(model%comm%rank) + 1; last = block_start(model%comm%rank + 1)
+    else if (.not. model%comm%is_root()) then
+      last = 0
+    end if
     do k = 1, hist%nsnap
       call gather_snapshot(hist%snap(k))
     end do
     m = model%pts%row_size()
     allocate(rows(m, np))
     call model%pts%pack_rows([(k, k = 1, np)], rows)
-    call model%comm%gather_rows(rows, np, all)
-    if (.not. model%comm%is_root()) return
     oid = model%pts%id_row()
-    allocate(sorted(m, size(all, 2)))
+    if (by_block) then
+      dest = [(owner(nint(rows(oid, k))), k = 1, np)]
+      call model%comm%exchange_rows(rows, np, dest, all)
+    else
+      call model%comm%gather_rows(rows, np, all)
+      if (.not. model%comm%is_root()) return
+    end if
+    allocate(sorted(m, last - first + 1))
     do k = 1, size(all, 2)
-      sorted(:, nint(all(oid, k))) = all(:, k)
+      sorted(:, nint(all(oid, k)) - first + 1) = all(:, k)
     end do
     call model%pts%set_from_rows(nd, ns, sorted, size(sorted, 2), e)
     if (e%code /= 0) then
@@ -318,8 +341,20 @@ contains
 
   contains
 
+    ! The first id's position (0-based) of process r's block; block_start(P) = N.
+    integer function block_start(r)
+      integer, intent(in) :: r
+      block_start = int((int(r, int64) * ntotal) / model%comm%nranks)
+    end function block_start
+
+    ! The process whose block holds id i: the r with ⌊rN/P⌋ < i ≤ ⌊(r + 1)N/P⌋.
+    integer function owner(i)
+      integer, intent(in) :: i
+      owner = int((int(i, int64) * model%comm%nranks - 1) / ntotal)
+    end function owner
+
     ! One snapshot's particles (in the order of its ids: the process's particles when it was
-    ! taken).
+    ! taken), to the root or to the processes of their blocks.
     subroutine gather_snapshot(sn)
       type(empm_snapshot_t), intent(inout) :: sn
       real(wp), allocatable :: r(:,:), a(:,:), srt(:,:)
@@ -335,18 +370,22 @@ contains
         r(o + 13, q) = sn%m(q); r(o + 14, q) = sn%vol(q); r(o + 15, q) = sn%rho(q)
         r(o + 16:o + 15 + ns, q) = sn%state(:, q)
       end do
-      call model%comm%gather_rows(r, n, a)
-      if (.not. model%comm%is_root()) return
-      allocate(srt(mm, size(a, 2)))
+      if (by_block) then
+        call model%comm%exchange_rows(r, n, [(owner(sn%id(q)), q = 1, n)], a)
+      else
+        call model%comm%gather_rows(r, n, a)
+        if (.not. model%comm%is_root()) return
+      end if
+      allocate(srt(mm, last - first + 1))
       do q = 1, size(a, 2)
-        srt(:, nint(a(1, q))) = a(:, q)
+        srt(:, nint(a(1, q)) - first + 1) = a(:, q)
       end do
       o = 1 + 2 * nd
       sn%x = srt(2:1 + nd, :); sn%v = srt(2 + nd:1 + 2 * nd, :)
       sn%stress = srt(o + 1:o + 6, :); sn%strain = srt(o + 7:o + 12, :)
       sn%m = srt(o + 13, :); sn%vol = srt(o + 14, :); sn%rho = srt(o + 15, :)
       sn%state = srt(o + 16:o + 15 + ns, :)
-      sn%id = [(q, q = 1, size(srt, 2))]
+      sn%id = [(q, q = first, last)]
     end subroutine gather_snapshot
   end subroutine empm_gather_particles
 end module empm_partition

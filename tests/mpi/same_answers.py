@@ -5,7 +5,10 @@ is compared. A dataset's difference is max|a - b| over the largest magnitude the
 in the file (over all frames: a field near a zero crossing at one snapshot is not compared with
 its own tiny value). One process under mpirun must be bitwise the serial run.
 
-Usage: same_answers.py EMPM MPIRUN WORKDIR [--ranks 2,3,4] [--quick]
+Usage: same_answers.py EMPM MPIRUN WORKDIR [--ranks 2,3,4] [--quick] [--writers all|1]
+--writers: every output must have been written by all the processes (parallel HDF5) or by 1
+(the root); the root attribute `writers` says which. Integer datasets must be equal, and the
+XDMF files equal but for the HDF5 file's name.
 Exit status 0 when every comparison is within the bound, 1 otherwise (one line per failure).
 """
 import itertools
@@ -235,7 +238,7 @@ def compare(a_path, b_path):
 
         def visit(name, obj):
             nonlocal worst, where, same
-            if not isinstance(obj, h5py.Dataset) or obj.dtype.kind != "f":
+            if not isinstance(obj, h5py.Dataset):
                 return
             if name not in b:
                 worst, where, same = np.inf, name + " (missing)", False
@@ -243,6 +246,12 @@ def compare(a_path, b_path):
             x, y = obj[...], b[name][...]
             if x.shape != y.shape:
                 worst, where, same = np.inf, name + f" (shape {x.shape} vs {y.shape})", False
+                return
+            if obj.dtype.kind != "f":
+                # Integers (materials, the XDMF vertices) are the same on any number of
+                # processes.
+                if not np.array_equal(x, y):
+                    worst, where, same = np.inf, name + " (integers differ)", False
                 return
             if x.size == 0:
                 return
@@ -253,6 +262,10 @@ def compare(a_path, b_path):
             if d > worst:
                 worst, where = d, name
         a.visititems(visit)
+    # The XDMF files (one per run, the root's) name their HDF5 file; otherwise equal.
+    xa, xb = pathlib.Path(a_path).with_suffix(".xmf"), pathlib.Path(b_path).with_suffix(".xmf")
+    if xa.read_text().replace(xa.stem + ".h5", "F") != xb.read_text().replace(xb.stem + ".h5", "F"):
+        worst, where, same = np.inf, "the XDMF files differ", False
     return worst, where, same
 
 
@@ -265,6 +278,7 @@ def main():
     empm, mpirun, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
     ranks = [2, 3, 4]
     quick = "--quick" in sys.argv
+    writers = sys.argv[sys.argv.index("--writers") + 1] if "--writers" in sys.argv else None
     if "--ranks" in sys.argv:
         ranks = [int(k) for k in sys.argv[sys.argv.index("--ranks") + 1].split(",")]
     work.mkdir(parents=True, exist_ok=True)
@@ -302,6 +316,10 @@ def main():
                 continue
             worst, where, same = compare(work / f"{tag}_s.h5", work / out)
             ok = same if n == 1 else worst <= TOL
+            with h5py.File(work / out, "r") as f:
+                wrote = int(f.attrs["writers"])
+            if writers is not None and wrote != (n if writers == "all" else int(writers)):
+                ok, same, worst, where = False, False, np.inf, f"written by {wrote} processes"
             print(f"{'ok  ' if ok else 'FAIL'} {tag:32s} -n {n}: "
                   f"{'bitwise' if same else f'{worst:.2e} ({where})'}")
             failures += 0 if ok else 1

@@ -1,11 +1,12 @@
 # Run shear.nml with a bare relative output name, then open the XDMF file with the readers:
 # by absolute path from another folder, by bare name from its folder (the XDMF 2 reader; the
 # Xdmf3 library resolves a bare name against itself, 'x.xmfx.h5', so it gets './x.xmf').
-# -DEXE= -DPYTHON= -DCASE= -DCHECK= -DWORK_DIR=
+# -DEXE= -DPYTHON= -DCASE= -DCHECK= -DWORK_DIR= [-DLAUNCH="mpirun;-n;3;..."]: with LAUNCH the
+# run is made by several processes (the file they write together in an MPI build).
 set(run_dir ${WORK_DIR}/run)
 file(REMOVE_RECURSE ${WORK_DIR})
 file(MAKE_DIRECTORY ${run_dir})
-execute_process(COMMAND ${EXE} run ${CASE} -o shear.h5 WORKING_DIRECTORY ${run_dir}
+execute_process(COMMAND ${LAUNCH} ${EXE} run ${CASE} -o shear.h5 WORKING_DIRECTORY ${run_dir}
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
 message(STATUS "empm run: status ${rc}\n${out}${err}")
 if(NOT rc EQUAL 0)
