@@ -12,7 +12,7 @@ module empm_comm
     MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_SUM, &
     MPI_Op, MPI_MAX, MPI_MIN, MPI_LOR, MPI_Bcast, MPI_Alltoall, MPI_Alltoallv, MPI_CHARACTER, &
     MPI_Gather, MPI_Gatherv, MPI_Barrier, MPI_Allgather, MPI_Request, MPI_Isend, MPI_Irecv, &
-    MPI_Waitall, MPI_STATUSES_IGNORE, operator(/=)
+    MPI_Waitall, MPI_STATUSES_IGNORE, MPI_Abort, operator(/=)
 #endif
   implicit none
   private
@@ -54,6 +54,7 @@ module empm_comm
     procedure :: allgather_ints => comm_allgather_ints
     procedure :: swap => comm_swap
     procedure :: barrier => comm_barrier
+    procedure :: abort => comm_abort
     procedure :: finish => comm_finish
   end type empm_comm_t
 
@@ -464,6 +465,27 @@ contains
     associate (unused => [nbr, ptr, m], unused_s => sbuf, unused_r => rbuf); end associate
 #endif
   end subroutine comm_swap
+
+  !> End every process of the job with exit status `code` (MPI_Abort): for a failure the
+  !> processes cannot recover from together. One process: stop with `code`.
+  subroutine comm_abort(self, code)
+    class(empm_comm_t), intent(in) :: self !! communicator
+    integer, intent(in) :: code            !! exit status
+#ifdef EMPM_USE_MPI
+    if (self%nranks > 1) call MPI_Abort(self%handle, code)
+#endif
+    ! A constant stop code (Fortran 2008): the statuses empm uses.
+    select case (code)
+    case (2)
+      error stop 2
+    case (3)
+      error stop 3
+    case (4)
+      error stop 4
+    case default
+      error stop 1
+    end select
+  end subroutine comm_abort
 
   !> Wait for every process.
   subroutine comm_barrier(self)

@@ -69,7 +69,7 @@ contains
     logical, intent(in), optional :: together          !! all processes write it (blocks)
     integer(hid_t) :: fid, g, gs, gk
     character(len=:), allocatable :: tmp
-    integer :: e, ierr, k, n, nd, oserr, info
+    integer :: e, ierr, k, n, nd, oserr, info, th(1)
     type(empm_shared_file_t) :: sf
     n = model%pts%np
     call h5open_f(e)
@@ -86,7 +86,10 @@ contains
     call h5_attr(fid, 'format_version', FORMAT_VERSION, ierr)
     call h5_attr(fid, 'empm_version', empm_version(), ierr)
     call h5_attr(fid, 'case_text', case_text, ierr)
-    call h5_attr(fid, 'threads', empm_max_threads(), ierr)
+    ! The root's (an attribute of a file written together is the same on every process).
+    th(1) = empm_max_threads()
+    if (sf%together) call model%comm%bcast_ints(th, 0)
+    call h5_attr(fid, 'threads', th(1), ierr)
     call h5_attr(fid, 'particles', sf%ntotal, ierr)
     call h5_attr(fid, 'ndim', nd, ierr)
     call h5_attr(fid, 'nstate', model%pts%nstate, ierr)
@@ -185,7 +188,7 @@ contains
     call h5_close_group(gs, ierr)
     call h5_close_group(g, ierr)
 
-    call sf%close(model%comm, fid, ierr, oserr)
+    call sf%close(model%comm, path, tmp, fid, ierr, oserr)
     if (.not. sf%root) return
     if (ierr /= 0) then
       info = empm_remove(tmp)

@@ -74,11 +74,11 @@ contains
   end subroutine h5_close_group
 
   subroutine write_r1(loc, name, a, ierr, part)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
+    integer(hid_t), intent(in) :: loc                 !! parent file or group
+    character(len=*), intent(in) :: name              !! dataset name
     real(wp), intent(in) :: a(:)
     integer, intent(inout) :: ierr
-    type(h5_part_t), intent(in), optional :: part
+    type(h5_part_t), intent(in), optional :: part !! this process's part (written together)
     integer(hsize_t) :: dims(1)
     integer(hid_t) :: fsid, msid, did, xfer
     integer :: e(5)
@@ -93,11 +93,11 @@ contains
   end subroutine write_r1
 
   subroutine write_r2(loc, name, a, ierr, part)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
+    integer(hid_t), intent(in) :: loc                 !! parent file or group
+    character(len=*), intent(in) :: name              !! dataset name
     real(wp), intent(in) :: a(:,:)
     integer, intent(inout) :: ierr
-    type(h5_part_t), intent(in), optional :: part
+    type(h5_part_t), intent(in), optional :: part !! this process's part (written together)
     integer(hsize_t) :: dims(2)
     integer(hid_t) :: fsid, msid, did, xfer
     integer :: e(5)
@@ -112,11 +112,11 @@ contains
   end subroutine write_r2
 
   subroutine write_i1(loc, name, a, ierr, part)
-    integer(hid_t), intent(in) :: loc
-    character(len=*), intent(in) :: name
+    integer(hid_t), intent(in) :: loc                 !! parent file or group
+    character(len=*), intent(in) :: name              !! dataset name
     integer, intent(in) :: a(:)
     integer, intent(inout) :: ierr
-    type(h5_part_t), intent(in), optional :: part
+    type(h5_part_t), intent(in), optional :: part !! this process's part (written together)
     integer(hsize_t) :: dims(1)
     integer(hid_t) :: fsid, msid, did, xfer
     integer :: e(5)

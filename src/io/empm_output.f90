@@ -23,6 +23,7 @@
 !> so no 6-value order reads right in both (docs/paraview.md).
 module empm_output
   use, intrinsic :: ieee_arithmetic, only: ieee_value, ieee_quiet_nan
+  use, intrinsic :: iso_fortran_env, only: error_unit
   use hdf5, only: h5open_f, h5fcreate_f, h5fclose_f, H5F_ACC_EXCL_F, h5eset_auto_f, &
     h5dont_atexit_f
   use empm_kinds, only: wp
@@ -93,7 +94,7 @@ contains
     logical, intent(in), optional :: together          !! all processes write it (blocks)
     integer(hid_t) :: fid, g, gs, gp
     integer :: ierr, e, k, info, n, oserr, np
-    character(len=:), allocatable :: tmp, xmf, xtmp
+    character(len=:), allocatable :: tmp, xmf, xtmp, stat
     character(len=16) :: sname
     character(len=STATE_NAME_LEN), allocatable :: snames(:)
     integer, allocatable :: scol(:,:)
@@ -117,11 +118,11 @@ contains
     end if
     call h5_attr(fid, 'empm_version', empm_version(), ierr)
     call h5_attr(fid, 'complete', merge(1, 0, complete), ierr)
-    if (complete) then
-      call h5_attr(fid, 'status', 'completed', ierr)
-    else
-      call h5_attr(fid, 'status', trim('stopped: '//status), ierr)
-    end if
+    ! An attribute of a file written together must be the same on every process: the root's.
+    stat = 'completed'
+    if (.not. complete) stat = trim('stopped: '//status)
+    if (sf%together) call model%comm%bcast_text(stat, 0)
+    call h5_attr(fid, 'status', stat, ierr)
     call h5_attr(fid, 'case_file', meta%case_file, ierr)
     call h5_attr(fid, 'case_text', meta%case_text, ierr)
     call h5_attr(fid, 'shape', meta%shape, ierr)
@@ -217,7 +218,7 @@ contains
 
     ! Every group, dataset and attribute is closed by now (the helpers close what they open
     ! even on failure): only the file is left.
-    call sf%close(model%comm, fid, ierr, oserr)
+    call sf%close(model%comm, path, tmp, fid, ierr, oserr)
     if (.not. sf%root) return
     if (ierr /= 0) then
       info = empm_remove(tmp)
@@ -274,16 +275,22 @@ contains
       tmp = empm_partial_name(path)
     end if
     fid = 0; e = 0
-    ! Collective (it duplicates the communicator): only when all processes are here.
-    if (self%together) call h5_mpio_properties(comm, self%fapl, self%xfer, e)
-    if (e == 0) then
-      if (self%together) then
+    if (self%together) then
+      ! Collective (the file access list duplicates the communicator, the create opens the
+      ! file on all): every process goes on only if all can.
+      call h5_mpio_properties(comm, self%fapl, self%xfer, e)
+      e = comm%max_int(abs(e))
+      if (e == 0) then
         call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e, access_prp=self%fapl)
-      else
-        call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e)
+        ! Created on some processes only: the open file cannot be closed by them alone.
+        if (comm%max_int(abs(e)) /= 0 .and. e == 0) &
+          call abort_write(comm, path, 'the parallel create of '//tmp//' failed on another '// &
+            'process', tmp)
+        e = comm%max_int(abs(e))
       end if
+    else
+      call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e)
     end if
-    if (self%together) e = comm%max_int(abs(e))
     ! Particle datasets: this process's columns of ntotal. Others: the root's array.
     self%pp = h5_part_t(first=self%first, total=merge(self%ntotal, -1, self%together), &
       writes=.true., xfer=self%xfer)
@@ -292,10 +299,15 @@ contains
   end subroutine shared_create
 
   !> Close the file; ierr (in: this process's write failures) and oserr (the system's reason)
-  !> become the worst over the processes.
-  subroutine shared_close(self, comm, fid, ierr, oserr)
+  !> become the worst over the processes. Written together, a write that failed on any
+  !> process cannot be undone collectively (parallel HDF5's state of the file then differs
+  !> between the processes, and closing it hangs or crashes): the root reports it, removes
+  !> the partial file `tmp` and the job ends with status 4 ([[abort_write]]).
+  subroutine shared_close(self, comm, path, tmp, fid, ierr, oserr)
     class(empm_shared_file_t), intent(inout) :: self !! the file's writers
     type(empm_comm_t), intent(in) :: comm            !! the processes it was created with
+    character(len=*), intent(in) :: path             !! final name
+    character(len=*), intent(in) :: tmp              !! partial name
     integer(hid_t), intent(in) :: fid                !! the open file
     integer, intent(inout) :: ierr                   !! ≠ 0: a write failed
     integer, intent(out) :: oserr                    !! errno of the failure, 0 if none
@@ -303,6 +315,13 @@ contains
     ! errno now is the reason of a failed write (HDF5 keeps it); a failed close sets it too.
     oserr = 0
     if (ierr /= 0) oserr = empm_errno()
+    if (self%together) then
+      if (comm%max_int(abs(ierr)) /= 0) then
+        oserr = comm%max_int(oserr)
+        call abort_write(comm, path, 'writing '//tmp//' failed: '// &
+          empm_write_reason(oserr), tmp)
+      end if
+    end if
     call h5fclose_f(fid, e)
     call h5_mpio_close(self%fapl, self%xfer)
     self%fapl = 0; self%xfer = 0
@@ -315,6 +334,27 @@ contains
       oserr = comm%max_int(oserr)
     end if
   end subroutine shared_close
+
+  !> A failure of a file written together that the processes cannot recover from: the root
+  !> prints `why` for `path`, removes the partial file `tmp`, and the job ends with status 4
+  !> (EMPM_ERR_IO) on every process. Collective.
+  subroutine abort_write(comm, path, why, tmp)
+    type(empm_comm_t), intent(in) :: comm !! the processes writing it
+    character(len=*), intent(in) :: path  !! final name
+    character(len=*), intent(in) :: why   !! what failed
+    character(len=*), intent(in) :: tmp   !! partial name
+    integer :: info
+    if (comm%is_root()) then
+      info = empm_remove(tmp)
+      call empm_output_release(path) ! the results' lock, if this is the results file
+      write(error_unit, '(a)') 'empm: error: '//path//': '//why//'; the processes writing '// &
+        'it together (parallel HDF5) cannot close it consistently, so the run ends here ' &
+        //'(status 4)'
+      flush(error_unit)
+    end if
+    call comm%barrier()
+    call comm%abort(EMPM_ERR_IO)
+  end subroutine abort_write
 
   subroutine write_state(g, pts, pp, ierr)
     integer(hid_t), intent(in) :: g

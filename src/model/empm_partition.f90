@@ -336,6 +336,9 @@ contains
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
+    ! The root's model stays a whole one (material runs, basis storage); a block is written
+    ! and dropped, so it needs none.
+    if (by_block) return
     call model%set_runs(e)
     if (e%code /= 0) call empm_raise_error(e, err)
 

@@ -8,10 +8,13 @@
 4. case 1 with a surface traction and checkpoints (its loaded particles shared out, the
    checkpoints gathered) stops the same way, with the serial run's message and last good state;
 5. a file the case needs that is missing on one process only (its own working folder, with
-   mpirun's MPMD form) gives status 2 and one message naming the file, on every process.
+   mpirun's MPMD form) gives status 2 and one message naming the file, on every process;
+6. an output that one process cannot write (its file size limited) gives status 4 and one
+   message naming the file, and leaves no partial file.
 No process may hang: each run has a time limit.
 
-Usage: stops.py EMPM MPIRUN WORKDIR [--ranks 2,3]
+Usage: stops.py EMPM MPIRUN WORKDIR [--ranks 2,3] [--writers all|1]
+--writers: how the build writes its output (all processes together, or the root: case 6).
 """
 import os
 import pathlib
@@ -79,6 +82,7 @@ def error_lines(log):
 def main():
     empm, mpirun, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
     ranks = [2, 3]
+    writers = sys.argv[sys.argv.index("--writers") + 1] if "--writers" in sys.argv else "all"
     if "--ranks" in sys.argv:
         ranks = [int(k) for k in sys.argv[sys.argv.index("--ranks") + 1].split(",")]
     work.mkdir(parents=True, exist_ok=True)
@@ -135,6 +139,34 @@ def main():
         fails.append(f"missing file on process 1: exit {rc}, messages {errs}: {log[-400:]}")
     else:
         print(f"ok   missing file on process 1 of 2: exit {rc}: {errs[0][:110]}")
+    # 6. The output cannot be written by one process (its file size limited, as by a full
+    # disk or a quota): status 4 on every process, one message naming the file and the reason,
+    # no partial file left, no hang. Written together (parallel HDF5) the job ends there
+    # (MPI_Abort); written by the root, the root alone writes and fails.
+    (work / "C").mkdir(exist_ok=True)
+    # Case 1 with its right block slowed so that it stays on the grid: a run that completes.
+    (work / "C" / "leave.nml").write_text(LEAVE.replace("t_end = 1.0", "t_end = 0.1")
+                                          .replace("velocity = 3.0, 0.0", "velocity = 0.3, 0.0"))
+    for limited in range(2):
+        for f in (work / "C").glob("full*"):
+            f.unlink()
+        shell = ('if [ "$OMPI_COMM_WORLD_RANK" = ' + str(limited) + ' ]; then trap "" XFSZ; '
+                 'ulimit -f 8; fi; exec "$0" run leave.nml -o full.h5')
+        rc, log = run(mpi + ["-n", "2", "sh", "-c", shell, empm], work / "C")
+        errs = error_lines(log)
+        left = sorted(f.name for f in (work / "C").glob("full*.partial"))
+        if writers == "1" and limited != 0:
+            # Only the root writes: the limited process has nothing to write.
+            if rc != 0 or errs or left:
+                fails.append(f"root writes, process {limited} limited: exit {rc}, {errs}")
+            else:
+                print(f"ok   write limited on process {limited} of 2, the root writes: exit 0")
+            continue
+        if rc != 4 or len(errs) != 1 or "full.h5" not in errs[0] or left:
+            fails.append(f"write failure on process {limited}: exit {rc}, messages {errs}, "
+                         f"partial files {left}: {log[-400:]}")
+        else:
+            print(f"ok   write failure on process {limited} of 2: exit {rc}: {errs[0][:110]}")
     for f in fails:
         print("FAIL", f)
     return 1 if fails else 0
