@@ -31,7 +31,7 @@ module empm_capi
   use empm_output, only: empm_write_results, empm_output_meta_t
   use empm_driver, only: empm_run_case, empm_agree_error
   use empm_comm, only: empm_comm_t, empm_comm_from_handle, empm_comm_handle_problem
-  use empm_partition, only: empm_partition_particles, empm_gather_particles
+  use empm_partition, only: empm_partition_particles, empm_gather_particles, empm_copy_for_output
   use empm_h5_mpio, only: empm_h5_collective
   implicit none
   private
@@ -720,7 +720,8 @@ contains
       type(empm_model_t), allocatable :: whole
       type(empm_history_t), allocatable :: hall
       logical :: together
-      allocate(whole, source=b%model)
+      allocate(whole)
+      call empm_copy_for_output(b%model, whole)
       allocate(hall, source=b%hist)
       together = empm_h5_collective(b%model%comm)
       call empm_gather_particles(whole, hall, e, blocks=together)

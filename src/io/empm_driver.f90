@@ -18,7 +18,7 @@ module empm_driver
   use empm_strings, only: str
   use empm_kinds, only: wp
   use empm_comm, only: empm_comm_t
-  use empm_partition, only: empm_partition_particles, empm_gather_particles
+  use empm_partition, only: empm_partition_particles, empm_gather_particles, empm_copy_for_output
   use empm_h5_mpio, only: empm_h5_collective
   implicit none
   private
@@ -55,7 +55,8 @@ contains
     ! restart from it. Written by all together, each a block of ids (parallel HDF5), or by the
     ! root holding every particle.
     together = empm_h5_collective(model%comm)
-    whole = model; hwhole = hist
+    call empm_copy_for_output(model, whole)
+    hwhole = hist
     call empm_gather_particles(whole, hwhole, err, blocks=together)
     if (together) call empm_agree_error(model%comm, err)
     if (err%code == EMPM_OK .and. (together .or. model%comm%is_root())) &

@@ -76,9 +76,9 @@ contains
   subroutine write_r1(loc, name, a, ierr, part)
     integer(hid_t), intent(in) :: loc                 !! parent file or group
     character(len=*), intent(in) :: name              !! dataset name
-    real(wp), intent(in) :: a(:)
-    integer, intent(inout) :: ierr
-    type(h5_part_t), intent(in), optional :: part !! this process's part (written together)
+    real(wp), intent(in) :: a(:)                      !! values (last extent: columns)
+    integer, intent(inout) :: ierr                    !! set non-zero on failure
+    type(h5_part_t), intent(in), optional :: part     !! this process's part (written together)
     integer(hsize_t) :: dims(1)
     integer(hid_t) :: fsid, msid, did, xfer
     integer :: e(5)
@@ -95,9 +95,9 @@ contains
   subroutine write_r2(loc, name, a, ierr, part)
     integer(hid_t), intent(in) :: loc                 !! parent file or group
     character(len=*), intent(in) :: name              !! dataset name
-    real(wp), intent(in) :: a(:,:)
-    integer, intent(inout) :: ierr
-    type(h5_part_t), intent(in), optional :: part !! this process's part (written together)
+    real(wp), intent(in) :: a(:,:)                    !! values (last extent: columns)
+    integer, intent(inout) :: ierr                    !! set non-zero on failure
+    type(h5_part_t), intent(in), optional :: part     !! this process's part (written together)
     integer(hsize_t) :: dims(2)
     integer(hid_t) :: fsid, msid, did, xfer
     integer :: e(5)
@@ -114,9 +114,9 @@ contains
   subroutine write_i1(loc, name, a, ierr, part)
     integer(hid_t), intent(in) :: loc                 !! parent file or group
     character(len=*), intent(in) :: name              !! dataset name
-    integer, intent(in) :: a(:)
-    integer, intent(inout) :: ierr
-    type(h5_part_t), intent(in), optional :: part !! this process's part (written together)
+    integer, intent(in) :: a(:)                       !! values (last extent: columns)
+    integer, intent(inout) :: ierr                    !! set non-zero on failure
+    type(h5_part_t), intent(in), optional :: part     !! this process's part (written together)
     integer(hsize_t) :: dims(1)
     integer(hid_t) :: fsid, msid, did, xfer
     integer :: e(5)

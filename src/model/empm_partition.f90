@@ -11,6 +11,7 @@ module empm_partition
   implicit none
   private
   public :: empm_partition_particles, empm_share_traction_state, empm_gather_particles, empm_rebalance
+  public :: empm_copy_for_output
 
 contains
 
@@ -283,6 +284,26 @@ contains
       end associate
     end do
   end subroutine keep_tractions
+
+  !> What writing the results or a checkpoint reads of a model, copied: the grid's geometry,
+  !> the particles, the shape family and materials (their names and state variables), the
+  !> loads (the tractions' state), the communicator, time, step and residual. Not the nodal
+  !> fields, the basis or the halo, which for LME shapes outweigh the particles: a process
+  !> writing while its run goes on (a checkpoint, `empm_model_write`) then holds two copies of
+  !> its particles only.
+  subroutine empm_copy_for_output(model, copy)
+    type(empm_model_t), intent(in) :: model    !! the running model
+    type(empm_model_t), intent(out) :: copy    !! its copy for output
+    copy%grid = model%grid
+    copy%pts = model%pts
+    if (allocated(model%shape)) allocate(copy%shape, source=model%shape)
+    if (allocated(model%mats)) copy%mats = model%mats
+    copy%loads = model%loads
+    copy%comm = model%comm
+    if (allocated(model%boxes)) copy%boxes = model%boxes
+    copy%t = model%t; copy%step = model%step
+    copy%track = model%track; copy%residual = model%residual
+  end subroutine empm_copy_for_output
 
   !> After a parallel run: the root process gets every particle, in id (generation) order,
   !> and every snapshot likewise, to write the results as a serial run would; the other
