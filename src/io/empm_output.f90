@@ -261,6 +261,7 @@ contains
     integer(hid_t), intent(out) :: fid                      !! the open file
     integer, intent(out) :: e                               !! 0 on success
     integer :: counts(1, comm%nranks)
+    logical :: created
     self%together = .false.
     if (present(together)) self%together = together .and. empm_h5_collective(comm)
     self%root = comm%is_root() .or. .not. self%together
@@ -282,11 +283,11 @@ contains
       e = comm%max_int(abs(e))
       if (e == 0) then
         call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e, access_prp=self%fapl)
-        ! Created on some processes only: the open file cannot be closed by them alone.
-        if (comm%max_int(abs(e)) /= 0 .and. e == 0) &
-          call abort_write(comm, path, 'the parallel create of '//tmp//' failed on another '// &
-            'process', tmp)
+        created = e == 0
         e = comm%max_int(abs(e))
+        ! Created on some processes only: the open file cannot be closed by them alone.
+        if (e /= 0 .and. comm%any_true(created)) call abort_write(comm, path, &
+          'the parallel create of '//tmp//' failed on some of the processes', tmp)
       end if
     else
       call h5fcreate_f(tmp, H5F_ACC_EXCL_F, fid, e)
