@@ -29,10 +29,9 @@ module empm_capi
   use empm_case, only: empm_case_t
   use empm_input, only: empm_read_case
   use empm_output, only: empm_write_results, empm_output_meta_t
-  use empm_driver, only: empm_run_case, empm_agree_error
+  use empm_driver, only: empm_run_case, empm_write_shared
   use empm_comm, only: empm_comm_t, empm_comm_from_handle, empm_comm_handle_problem
-  use empm_partition, only: empm_partition_particles, empm_gather_particles, empm_copy_for_output
-  use empm_h5_mpio, only: empm_h5_collective
+  use empm_partition, only: empm_partition_particles, empm_copy_for_output
   implicit none
   private
   public :: empm_capi_box_t
@@ -719,16 +718,10 @@ contains
     subroutine write_gathered()
       type(empm_model_t), allocatable :: whole
       type(empm_history_t), allocatable :: hall
-      logical :: together
       allocate(whole)
       call empm_copy_for_output(b%model, whole)
       allocate(hall, source=b%hist)
-      together = empm_h5_collective(b%model%comm)
-      call empm_gather_particles(whole, hall, e, blocks=together)
-      if (together) call empm_agree_error(b%model%comm, e)
-      if (e%code == EMPM_OK .and. (together .or. whole%comm%is_root())) &
-        call empm_write_results(trim(path), whole, hall, meta, .true., '', e, together)
-      call empm_agree_error(b%model%comm, e)
+      call empm_write_shared(trim(path), whole, hall, meta, .true., '', e)
     end subroutine write_gathered
   end function capi_write
 

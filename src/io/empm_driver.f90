@@ -22,7 +22,7 @@ module empm_driver
   use empm_h5_mpio, only: empm_h5_collective
   implicit none
   private
-  public :: empm_run_case, empm_agree_error
+  public :: empm_run_case, empm_agree_error, empm_write_shared
 
   ! Checkpoints next to the results file, and the stop signal the program caught (if it
   ! installed the handlers: `empm run` does, the library does not).
@@ -64,6 +64,29 @@ contains
       together)
     call empm_agree_error(model%comm, err)
   end subroutine hook_checkpoint
+
+  !> Write the results of a run shared among the processes of `model%comm` (or of a serial
+  !> one) to `path`, as [[empm_write_results]]: each process gets a block of consecutive ids
+  !> and they write the file together (parallel HDF5), or the root gets every particle and
+  !> writes it as a serial run does. Collective; every process returns the same `err`.
+  !> `model` and `hist` then hold a block, or everything on the root: give copies
+  !> ([[empm_copy_for_output]]) when the run goes on.
+  subroutine empm_write_shared(path, model, hist, meta, complete, status, err)
+    character(len=*), intent(in) :: path            !! output HDF5 file
+    type(empm_model_t), intent(inout) :: model      !! final state (its particles replaced)
+    type(empm_history_t), intent(inout) :: hist     !! histories and snapshots (likewise)
+    type(empm_output_meta_t), intent(in) :: meta    !! root attributes
+    logical, intent(in) :: complete                 !! whether the run reached t_end
+    character(len=*), intent(in) :: status          !! '' or the message that stopped it
+    type(empm_error_t), intent(out) :: err          !! error, the same on every process
+    logical :: together
+    together = empm_h5_collective(model%comm)
+    call empm_gather_particles(model, hist, err, blocks=together)
+    if (together) call empm_agree_error(model%comm, err)
+    if (err%code == EMPM_OK .and. (together .or. model%comm%is_root())) &
+      call empm_write_results(path, model, hist, meta, complete, status, err, together)
+    call empm_agree_error(model%comm, err)
+  end subroutine empm_write_shared
 
   integer function hook_stop(self) result(sig)
     class(driver_hook_t), intent(inout) :: self
@@ -137,7 +160,7 @@ contains
     type(driver_hook_t) :: hook
     type(empm_solver_state_t) :: sst
     character(len=:), allocatable :: warning
-    logical :: resumed, together
+    logical :: resumed
     type(empm_history_t) :: hist
     type(empm_error_t) :: e, ew
     type(empm_output_meta_t) :: meta
@@ -213,20 +236,11 @@ contains
     meta%case_file = path; meta%case_text = cs%text
     meta%shape = cs%shape_name; meta%integrator = cs%scheme_name
     meta%cfl = cs%run%cfl; meta%t_end = cs%run%t_end
-    ! Several processes: each gets a block of consecutive ids and they write the file
-    ! together (parallel HDF5), or the root gets every particle and writes as a serial run.
-    together = empm_h5_collective(cs%model%comm)
-    call empm_gather_particles(cs%model, hist, ew, blocks=together)
-    if (together) call empm_agree_error(cs%model%comm, ew)
-    if (ew%code == EMPM_OK .and. (together .or. cs%model%comm%is_root())) then
-      if (e%code == EMPM_OK) then
-        call empm_write_results(cs%output_file, cs%model, hist, meta, .true., '', ew, together)
-      else
-        call empm_write_results(cs%output_file, cs%model, hist, meta, .false., e%message, ew, &
-          together)
-      end if
+    if (e%code == EMPM_OK) then
+      call empm_write_shared(cs%output_file, cs%model, hist, meta, .true., '', ew)
+    else
+      call empm_write_shared(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
     end if
-    call empm_agree_error(cs%model%comm, ew)
     call release()
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then
