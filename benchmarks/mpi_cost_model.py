@@ -3,10 +3,12 @@
 scaling to 1,024 processes of a 3D LME case with 1e8 particles, for the block-local design
 (each process its box of cells plus ghost node layers, shared nodes summed with its 26
 neighbours), from a measured per-particle cost and the network figures of a typical cluster.
-It models the block-local design the docs describe as the next stage; the last two columns
-compare today's design (the nodal sums exchanged with the neighbours over regions widened by the
-margin of docs/parallel.md, but every process's per-node passes over the whole grid, measured
-at 25 ns a node-step in 3D: `--node-pass-ns`) and the all-reduce of whole nodal arrays before it.
+It models the block-local design with ghost layers as deep as the family's support; the last
+two columns compare today's design (each process stores a window of the grid, its region -- the
+nodes its particles reach widened by the margin of docs/parallel.md -- plus 4 to 8 spare nodes
+a side, passes over it at 25 ns a node-step in 3D (`--node-pass-ns`), and exchanges the nodal
+sums over the regions' overlaps) and the all-reduce of whole nodal arrays with every process
+passing over the whole grid, two designs before it.
 
 Usage: mpi_cost_model.py [--alpha-us 1.5] [--gbytes 12.5] [--node 0.78] [--imbalance 1.05]
        [--node-pass-ns 25]
@@ -34,9 +36,9 @@ ALPHA = opt("--alpha-us", 1.5) * 1e-6       # s per message
 BETA = 1.0 / (opt("--gbytes", 12.5) * 1e9)  # s per byte
 NODE = opt("--node", 0.78)                  # on-node speed factor with every core busy
 IMB = opt("--imbalance", 1.05)              # largest process's share over the mean
-# Today's per-node passes (zeroing, divisions, constraints, the search for nearly-empty nodes,
-# the nodal screen) over the whole grid, per node and step of pc_newmark: 3D, one process, a
-# 100^3-cell grid holding 8 particles (1.28 s for 49 steps; 2D: 16 ns).
+# The per-node passes (zeroing, divisions, constraints, the search for nearly-empty nodes,
+# the nodal screen), per node and step of pc_newmark: 3D, one process, a 100^3-cell grid
+# holding 8 particles (1.28 s for 49 steps; 2D: 16 ns).
 NODE_PASS = opt("--node-pass-ns", 25.0) * 1e-9
 REACH = 0                                   # the family's reach in cells (set in main())
 COST, W = 7.0e-6, 3                         # set per table in main()
@@ -73,11 +75,14 @@ def step_time(n_particles, procs):
         # Today's design: every nodal array summed in full (ring allreduce: 2 (P-1)/P of it).
         replicated = sum(2 * (procs - 1) / procs * nodes_all * d * 8 * BETA
                          + 2 * math.ceil(math.log2(procs)) * ALPHA for d in SUMS)
-    # Today: the neighbours' regions overlap 2 (margin + reach + 1) layers deep (margin =
-    # 8 + 2 (reach + 1)), and every process passes over every node.
-    today = nodes_all * NODE_PASS
+    # Today: a process passes over its window, the block's nodes widened by the reach, the
+    # margin (8 + 2 (reach + 1)) and 6 spare nodes (4 to 8) a side; the neighbours' regions
+    # overlap 2 (margin + reach + 1) layers deep. One process: the whole grid.
+    margin = 8 + 2 * (REACH + 1)
+    side = m + 1 + 2 * (REACH + margin + 6)
+    today = (min(side ** 3, nodes_all) if procs > 1 else nodes_all) * NODE_PASS
     if procs > 1:
-        depth = 2 * (8 + 2 * (REACH + 1) + REACH + 1)
+        depth = 2 * (margin + REACH + 1)
         shared = 6 * (m + 1) ** 2 * depth + 12 * (m + 1) * depth ** 2 + 8 * depth ** 3
         for doubles in SUMS:
             today += 26 * ALPHA + 2 * shared * doubles * 8 * BETA

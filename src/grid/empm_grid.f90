@@ -2,6 +2,11 @@
 !>
 !> Nodes are numbered lexicographically, x fastest: node (i,j,k), 0-based per direction,
 !> has index `1 + i + n1*(j + n2*k)` with `n1, n2` the node counts along x and y.
+!>
+!> A grid may be a **window** of a larger one: the box of nodes a process of a parallel run
+!> stores (docs/parallel.md, "Block-local grids"). Its nodes are numbered as above within the
+!> window, `off` places it in the whole grid, and `inside`, `upper` and `whole` answer for
+!> the whole grid. A grid made by `init` is its own whole grid.
 module empm_grid
   use empm_kinds, only: wp, int64 => i8
   implicit none
@@ -17,6 +22,10 @@ module empm_grid
     integer :: ncell(3) = 1            !! cells per direction (1 along unused directions)
     integer :: nn(3) = 1               !! nodes per direction (1 along unused directions)
     integer :: nnode = 0               !! total number of nodes
+    integer :: off(3) = 0              !! window: the whole grid's 0-based (i,j,k) of this
+                                       !! grid's node (0,0,0); 0 for a whole grid
+    integer :: gnn(3) = 1              !! the whole grid's nodes per direction
+    real(wp) :: gorigin(3) = 0.0_wp    !! the whole grid's origin
   contains
     procedure :: init => grid_init
     procedure :: node_coord => grid_node_coord
@@ -25,6 +34,9 @@ module empm_grid
     procedure :: inside => grid_inside
     procedure :: hmin => grid_hmin
     procedure :: upper => grid_upper
+    procedure :: window => grid_window
+    procedure :: whole => grid_whole
+    procedure :: local_id => grid_local_id
   end type empm_grid_t
 
 contains
@@ -60,6 +72,7 @@ contains
     self%ncell(1:ndim) = ncell(1:ndim)
     self%nn(1:ndim) = ncell(1:ndim) + 1
     self%nnode = product(self%nn)
+    self%off = 0; self%gnn = self%nn; self%gorigin = self%origin
   end subroutine grid_init
 
   !> Coordinates of node `id` (first `ndim` entries meaningful, others 0).
@@ -95,15 +108,15 @@ contains
     ijk(2) = mod(r, self%nn(2)); ijk(3) = r / self%nn(2)
   end function grid_node_ijk
 
-  !> True when `x` lies in the closed grid box.
+  !> True when `x` lies in the closed box of the whole grid.
   pure logical function grid_inside(self, x) result(inside)
     class(empm_grid_t), intent(in) :: self !! grid
     real(wp), intent(in) :: x(:)           !! point, `ndim` entries
     integer :: d
     inside = .true.
     do d = 1, self%ndim
-      if (.not. (x(d) >= self%origin(d) .and. &
-                 x(d) <= self%origin(d) + self%ncell(d) * self%h(d))) inside = .false.
+      if (.not. (x(d) >= self%gorigin(d) .and. &
+                 x(d) <= self%gorigin(d) + (self%gnn(d) - 1) * self%h(d))) inside = .false.
     end do
   end function grid_inside
 
@@ -113,11 +126,49 @@ contains
     hm = minval(self%h(1:self%ndim))
   end function grid_hmin
 
-  !> Upper corner of the grid box.
+  !> Upper corner of the whole grid's box.
   pure function grid_upper(self) result(x)
     class(empm_grid_t), intent(in) :: self !! grid
     real(wp) :: x(3) !! upper corner (unused directions: 0)
     x = 0.0_wp
-    x(1:self%ndim) = self%origin(1:self%ndim) + self%ncell(1:self%ndim) * self%h(1:self%ndim)
+    x(1:self%ndim) = self%gorigin(1:self%ndim) + (self%gnn(1:self%ndim) - 1) * self%h(1:self%ndim)
   end function grid_upper
+
+  !> The window of the whole grid holding its nodes lo..hi (0-based (i,j,k), clipped to the
+  !> whole grid; unused directions ignored). Its origin is the whole grid's plus lo h.
+  pure function grid_window(self, lo, hi) result(w)
+    class(empm_grid_t), intent(in) :: self !! grid (whole or a window of it)
+    integer, intent(in) :: lo(3)           !! first node, whole-grid (i,j,k)
+    integer, intent(in) :: hi(3)           !! last node
+    type(empm_grid_t) :: w                 !! the window
+    integer :: nd, a(3), b(3)
+    nd = self%ndim
+    a = 0; b = 0
+    a(1:nd) = max(lo(1:nd), 0); b(1:nd) = min(hi(1:nd), self%gnn(1:nd) - 1)
+    b = max(a, b)
+    w = self
+    w%off = a
+    w%nn = b - a + 1
+    w%ncell = 0; w%ncell(1:nd) = w%nn(1:nd) - 1
+    w%nnode = product(w%nn)
+    w%origin = self%gorigin
+    w%origin(1:nd) = self%gorigin(1:nd) + a(1:nd) * self%h(1:nd)
+  end function grid_window
+
+  !> The whole grid this grid is a window of (itself when it is whole).
+  pure function grid_whole(self) result(g)
+    class(empm_grid_t), intent(in) :: self !! grid
+    type(empm_grid_t) :: g                 !! the whole grid
+    g = self
+    g%off = 0; g%nn = self%gnn; g%origin = self%gorigin
+    g%ncell = 0; g%ncell(1:self%ndim) = self%gnn(1:self%ndim) - 1
+    g%nnode = product(g%nn)
+  end function grid_whole
+
+  !> This grid's index of the whole grid's node (i,j,k) (0-based); 0 outside the window.
+  pure integer function grid_local_id(self, gijk) result(id)
+    class(empm_grid_t), intent(in) :: self !! grid
+    integer, intent(in) :: gijk(3)         !! whole-grid indices (unused directions: 0)
+    id = self%node_id(gijk - self%off)
+  end function grid_local_id
 end module empm_grid

@@ -15,8 +15,10 @@
 !> particles do not reach; meaningless beyond): they are never read there. A reduction over
 !> nodes counts each node once, on the lowest-ranked process whose core holds it (`owned`).
 !>
-!> The boxes are agreed at each basis evaluation (one small all-gather); the exchange plan is
-!> rebuilt only when a box changes. Serial runs never use it.
+!> The boxes are agreed before each basis evaluation (one small all-gather); the exchange
+!> plan is rebuilt only when a box changes, on the grid the process then stores (a window of
+!> the whole grid holding its region: [[empm_model_t:fit_window]]). Boxes are in the whole
+!> grid's node indices; lists and masks in the stored grid's. Serial runs never use it.
 module empm_halo
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
@@ -51,8 +53,10 @@ module empm_halo
     real(wp), allocatable :: rbuf(:)       !! receive buffer (3 size(list))
     integer, allocatable :: got(:,:)       !! every process's boxes as gathered (12, nranks)
     integer(int64) :: sent = 0             !! bytes sent by `sum` so far
+    logical :: replan = .false.            !! the boxes changed: [[halo_plan]] rebuilds the plan
   contains
     procedure :: update => halo_update
+    procedure :: plan => halo_plan
     procedure :: set_boxes => halo_set_boxes
     procedure :: in_core => halo_in_core
     procedure :: pack => halo_pack
@@ -63,10 +67,11 @@ module empm_halo
 
 contains
 
-  !> Agree on the boxes after a basis evaluation. `lo`, `hi`: this process's core, the nodes
-  !> (0-based ijk) its particles now reach (lo > hi: none). The core used is the union with
-  !> the last evaluation's, because a step may still map with the basis before this one.
-  !> Rebuilds the plan when any box changed. Collective.
+  !> Agree on the boxes before a basis evaluation. `lo`, `hi`: this process's core, the nodes
+  !> (whole-grid 0-based ijk) its particles now reach (lo > hi: none). The core used is the
+  !> union with the last evaluation's, because a step may still map nodal values of the basis
+  !> before this one. When any box changed, `replan` is set: the caller fits its storage to
+  !> the new region and calls [[halo_plan]]. Collective.
   subroutine halo_update(self, comm, grid, lo, hi, reach)
     class(empm_halo_t), intent(inout) :: self !! halo
     type(empm_comm_t), intent(in) :: comm     !! the run's processes
@@ -88,8 +93,8 @@ contains
       end if
     end if
     self%last(:, 1) = lo; self%last(:, 2) = hi
-    c(:, 1) = max(c(:, 1), 0); c(:, 2) = min(c(:, 2), grid%nn - 1)
-    r(:, 1) = max(c(:, 1) - self%margin, 0); r(:, 2) = min(c(:, 2) + self%margin, grid%nn - 1)
+    c(:, 1) = max(c(:, 1), 0); c(:, 2) = min(c(:, 2), grid%gnn - 1)
+    r(:, 1) = max(c(:, 1) - self%margin, 0); r(:, 2) = min(c(:, 2) + self%margin, grid%gnn - 1)
     if (any(c(:, 1) > c(:, 2))) then
       c(:, 1) = 0; c(:, 2) = -1; r = c
     end if
@@ -100,18 +105,31 @@ contains
     if (.not. allocated(self%got)) allocate(self%got(12, comm%nranks))
     call comm%allgather_ints(mine, self%got)
     if (allocated(self%core)) then
-      if (size(self%core, 3) == comm%nranks .and. size(self%owned) == grid%nnode) then
+      if (size(self%core, 3) == comm%nranks) then
         if (all(reshape(self%core, [6, comm%nranks]) == self%got(1:6, :)) .and. &
             all(reshape(self%region, [6, comm%nranks]) == self%got(7:12, :))) return
       end if
+      deallocate(self%core, self%region)
     end if
-    call self%set_boxes(grid, comm%rank, reshape(self%got(1:6, :), [3, 2, comm%nranks]), &
-                        reshape(self%got(7:12, :), [3, 2, comm%nranks]))
+    allocate(self%core(3, 2, comm%nranks), self%region(3, 2, comm%nranks))
+    self%core = reshape(self%got(1:6, :), [3, 2, comm%nranks])
+    self%region = reshape(self%got(7:12, :), [3, 2, comm%nranks])
+    self%replan = .true.
   end subroutine halo_update
 
-  !> Take every process's core and region (0-based node ijk boxes, lo > hi: empty) and build
-  !> the exchange plan and the ownership as process `me`: what [[halo_update]] does with the
-  !> boxes it gathered (public for tests).
+  !> After [[halo_update]] changed the boxes (`replan`): build the exchange plan and the
+  !> ownership on `grid`, the grid this process now stores (which must hold its region).
+  subroutine halo_plan(self, grid)
+    class(empm_halo_t), intent(inout) :: self !! halo
+    type(empm_grid_t), intent(in) :: grid     !! the stored grid (whole or a window)
+    if (.not. self%replan) return
+    call build_plan(self, grid, size(self%core, 3))
+    self%replan = .false.
+  end subroutine halo_plan
+
+  !> Take every process's core and region (whole-grid 0-based node ijk boxes, lo > hi: empty)
+  !> and build the exchange plan and the ownership as process `me`: what [[halo_update]] and
+  !> [[halo_plan]] do with the boxes gathered (public for tests).
   subroutine halo_set_boxes(self, grid, me, core, region)
     class(empm_halo_t), intent(inout) :: self !! halo
     type(empm_grid_t), intent(in) :: grid     !! background grid
@@ -119,10 +137,12 @@ contains
     integer, intent(in) :: core(:,:,:)        !! cores (3, 2, nranks)
     integer, intent(in) :: region(:,:,:)      !! regions (3, 2, nranks), each holding its core
     self%me = me
+    self%active = .true.
     if (allocated(self%core)) deallocate(self%core, self%region)
     allocate(self%core, source=core)
     allocate(self%region, source=region)
     call build_plan(self, grid, size(core, 3))
+    self%replan = .false.
   end subroutine halo_set_boxes
 
   ! The neighbours, their overlap lists, the rank-order merge plan and the ownership mask.
@@ -224,7 +244,8 @@ contains
     o(:, 1) = max(a(:, 1), b(:, 1)); o(:, 2) = min(a(:, 2), b(:, 2))
   end function overlap
 
-  ! The node ids of box b (0-based ijk), in increasing order.
+  ! The stored grid's node ids of box b (whole-grid 0-based ijk, inside the stored grid), in
+  ! increasing order.
   pure subroutine box_ids(grid, b, ids)
     type(empm_grid_t), intent(in) :: grid
     integer, intent(in) :: b(3, 2)
@@ -235,7 +256,8 @@ contains
       do j = b(2, 1), b(2, 2)
         do i = b(1, 1), b(1, 2)
           e = e + 1
-          ids(e) = 1 + i + grid%nn(1) * (j + grid%nn(2) * k)
+          ids(e) = 1 + (i - grid%off(1)) + grid%nn(1) * ((j - grid%off(2)) + &
+                                                         grid%nn(2) * (k - grid%off(3)))
         end do
       end do
     end do
@@ -250,7 +272,7 @@ contains
     integer :: ijk(3)
     yes = .true.
     if (.not. self%active) return
-    ijk = grid%node_ijk(id)
+    ijk = grid%node_ijk(id) + grid%off
     yes = all(ijk >= self%core(:, 1, self%me + 1) .and. ijk <= self%core(:, 2, self%me + 1))
   end function halo_in_core
 

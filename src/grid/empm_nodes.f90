@@ -11,6 +11,21 @@ module empm_nodes
   private
   public :: empm_nodes_t
 
+  ! The constraints in the whole grid's numbering, kept from set-up when a parallel run's nodal
+  ! storage first becomes a window ([[nodes_window]]): a boundary's worth of entries, from
+  ! which every later window takes its own.
+  type :: node_catalogue_t
+    logical :: made = .false.
+    integer, allocatable :: fix(:)         ! fixed dofs, positions d + ndim (G − 1), increasing
+    real(wp), allocatable :: vfix(:)       ! their prescribed velocities [m/s]
+    integer, allocatable :: set_ptr(:)     ! reaction sets: first dof of each in set_dof
+    integer, allocatable :: set_dof(:)     ! their dofs, as in fix
+    integer, allocatable :: ghost(:)       ! mirror ghosts (whole-grid ids)
+    integer, allocatable :: image(:)       ! their images
+    real(wp), allocatable :: msign(:,:)    ! their component signs (ndim, pairs)
+    type(empm_friction_t) :: fric          ! frictional wall nodes (whole-grid ids)
+  end type node_catalogue_t
+
   !> Nodal fields (structure of arrays, node index last).
   type :: empm_nodes_t
     integer :: ndim = 0                     !! spatial dimension
@@ -55,6 +70,8 @@ module empm_nodes
     real(wp), allocatable :: reaction(:,:)          !! reaction force of each set from the last
                                                     !! assembly (ndim, nset) [N], see
                                                     !! [[nodes_compute_reactions]]
+    type(node_catalogue_t), private :: cat          !! set-up's constraints in whole-grid
+                                                    !! numbering (windows only)
   contains
     procedure :: alloc => nodes_alloc
     procedure :: reset => nodes_reset
@@ -76,10 +93,130 @@ module empm_nodes
     procedure :: mirror_gather_even => nodes_mirror_gather_even
     procedure :: mirror_correct => nodes_mirror_correct
     procedure :: mirror_scatter => nodes_mirror_scatter
+    procedure :: window => nodes_window
     procedure, private :: list_fixed => nodes_list_fixed
   end type empm_nodes_t
 
 contains
+
+  !> Move the nodal storage from grid `old` to its window `new` (a parallel process's
+  !> block-local storage, docs/parallel.md): the fields keep their values on the nodes both
+  !> hold and are zero on the others; the fixed dofs, mirror pairs (both nodes in the window),
+  !> frictional wall nodes and reaction sets are set-up's, on the window's nodes. The first
+  !> call must start from the whole grid: it keeps set-up's constraints in the whole grid's
+  !> numbering. The nearly-empty nodes are found again at the next basis evaluation.
+  subroutine nodes_window(self, old, new)
+    class(empm_nodes_t), intent(inout) :: self !! nodal fields (on `old`)
+    type(empm_grid_t), intent(in) :: old       !! the grid the storage is on
+    type(empm_grid_t), intent(in) :: new       !! a window of the same whole grid
+    type(empm_grid_t) :: whole
+    integer, allocatable :: from(:), dofs(:), gh(:), im(:), keep(:)
+    integer :: n, nd, I, k, s, j, L
+    if (.not. self%cat%made) call make_catalogue(self, old)
+    whole = new%whole()
+    n = new%nnode; nd = self%ndim
+    allocate(from(n))
+    do I = 1, n
+      from(I) = old%local_id(new%node_ijk(I) + new%off)
+    end do
+    call move1(self%mass); call move1(self%vol)
+    call move2(self%mom); call move2(self%vel); call move2(self%force); call move2(self%acc)
+    call move2(self%work)
+    self%nnode = n
+    deallocate(self%fixed, self%vfix, self%mirrored)
+    allocate(self%fixed(nd, n), self%vfix(nd, n), self%mirrored(n))
+    self%fixed = .false.; self%vfix = 0.0_wp; self%mirrored = .false.
+    do k = 1, size(self%cat%fix)
+      j = local_dof(self%cat%fix(k))
+      if (j == 0) cycle
+      self%fixed(mod(j - 1, nd) + 1, (j - 1) / nd + 1) = .true.
+      self%vfix(mod(j - 1, nd) + 1, (j - 1) / nd + 1) = self%cat%vfix(k)
+    end do
+    call self%list_fixed()
+    ! Reaction sets: their dofs in the window, in the same order.
+    allocate(dofs(size(self%cat%set_dof)))
+    j = 0
+    do s = 1, self%nset
+      do k = self%cat%set_ptr(s), self%cat%set_ptr(s + 1) - 1
+        L = local_dof(self%cat%set_dof(k))
+        if (L == 0) cycle
+        j = j + 1; dofs(j) = L
+      end do
+      self%set_ptr(s + 1) = j + 1
+    end do
+    self%set_dof = dofs(1:j)
+    ! Mirror pairs with both nodes in the window (a pair cut by the window's edge lies beyond
+    ! the nodes the process's particles read: its margin, [[empm_halo]]).
+    allocate(gh(size(self%cat%ghost)), im(size(self%cat%ghost)), keep(size(self%cat%ghost)))
+    j = 0
+    do k = 1, size(self%cat%ghost)
+      gh(k) = new%local_id(whole%node_ijk(self%cat%ghost(k)))
+      im(k) = new%local_id(whole%node_ijk(self%cat%image(k)))
+      if (gh(k) == 0 .or. im(k) == 0) cycle
+      j = j + 1; keep(j) = k
+    end do
+    self%ghost = gh(keep(1:j)); self%image = im(keep(1:j))
+    self%msign = self%cat%msign(:, keep(1:j))
+    self%nmirror = j
+    self%mirrored(self%image) = .true.
+    ! Frictional wall nodes in the window.
+    call self%fric%init(nd)
+    do k = 1, self%cat%fric%n
+      L = new%local_id(whole%node_ijk(self%cat%fric%node(k)))
+      if (L == 0) cycle
+      call self%fric%add([L], self%cat%fric%axis(k), self%cat%fric%sgn(k), self%cat%fric%mu(k), &
+                         self%cat%fric%set(k))
+    end do
+    call self%ext%init(n)
+  contains
+    ! The window's dof position of a whole-grid dof position (0 outside the window).
+    integer function local_dof(gj)
+      integer, intent(in) :: gj
+      integer :: id
+      id = new%local_id(whole%node_ijk((gj - 1) / nd + 1))
+      local_dof = 0
+      if (id > 0) local_dof = mod(gj - 1, nd) + 1 + nd * (id - 1)
+    end function local_dof
+
+    subroutine move1(a)
+      real(wp), allocatable, intent(inout) :: a(:)
+      real(wp), allocatable :: b(:)
+      integer :: q
+      allocate(b(n))
+      do q = 1, n
+        b(q) = 0.0_wp
+        if (from(q) > 0) b(q) = a(from(q))
+      end do
+      call move_alloc(b, a)
+    end subroutine move1
+
+    subroutine move2(a)
+      real(wp), allocatable, intent(inout) :: a(:,:)
+      real(wp), allocatable :: b(:,:)
+      integer :: q
+      allocate(b(size(a, 1), n))
+      do q = 1, n
+        b(:, q) = 0.0_wp
+        if (from(q) > 0) b(:, q) = a(:, from(q))
+      end do
+      call move_alloc(b, a)
+    end subroutine move2
+  end subroutine nodes_window
+
+  ! Keep set-up's constraints in the whole grid's numbering (the storage is on `whole`).
+  subroutine make_catalogue(self, whole)
+    type(empm_nodes_t), intent(inout) :: self
+    type(empm_grid_t), intent(in) :: whole
+    if (any(whole%off /= 0) .or. any(whole%nn /= whole%gnn)) &
+      error stop 'empm_nodes: the first window must be taken from the whole grid'
+    self%cat%fix = self%fixed_dofs
+    self%cat%vfix = pack(self%vfix, self%fixed)
+    self%cat%set_ptr = self%set_ptr; self%cat%set_dof = self%set_dof
+    self%cat%ghost = self%ghost(1:self%nmirror); self%cat%image = self%image(1:self%nmirror)
+    self%cat%msign = self%msign(:, 1:self%nmirror)
+    self%cat%fric = self%fric
+    self%cat%made = .true.
+  end subroutine make_catalogue
 
   !> Allocate nodal storage for `grid`; no dof fixed. An allocation failure is reported in
   !> `err` when present (with the memory asked for), otherwise it stops the program.
@@ -103,6 +240,7 @@ contains
     end if
     self%fixed = .false.; self%vfix = 0.0_wp
     call self%list_fixed()
+    self%cat%made = .false.
     self%nset = 0
     if (allocated(self%set_name)) deallocate(self%set_name, self%set_ptr, self%set_dof, &
       self%set_fix, self%set_vel, self%reaction)

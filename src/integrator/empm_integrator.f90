@@ -253,6 +253,12 @@ contains
     if (present(again)) then
       if (again) call model%pts%rewind_shape_state()
     end if
+    ! The nodes the particles reach, and the window of the grid stored for them, come first:
+    ! the basis is numbered on that window.
+    if (model%comm%parallel()) then
+      call share_region(model)
+      if (present(ws)) call ws%fit(model%grid%nnode)
+    end if
     if (present(timer)) then
       call model%shape%eval_batch_iters(model%grid, model%pts, model%basis, ibad, info, iters)
       timer%newton_iters = timer%newton_iters + iters
@@ -267,15 +273,17 @@ contains
       call ws%set_ranges(model%basis)
     end if
     call agree_status(model, stat)
-    if (stat%code == 0 .and. model%comm%parallel()) call share_region(model)
   end subroutine eval_basis
 
-  !> Parallel runs: the nodes this process's particles reach on the new basis (the box of their
-  !> cells widened by the family's reach), agreed with the other processes ([[empm_halo]]).
+  !> Parallel runs: the nodes this process's particles reach at their current positions (the
+  !> box of their cells widened by the family's reach), agreed with the other processes
+  !> ([[empm_halo]]); when the boxes changed, the stored window of the grid is fitted to this
+  !> process's region ([[empm_model_t:fit_window]]) and the exchange plan rebuilt on it.
   subroutine share_region(model)
     type(empm_model_t), intent(inout) :: model !! simulation state
     real(wp) :: xlo(3), xhi(3)
     integer :: lo(3), hi(3), d, p, nd, reach
+    logical :: moved
     nd = model%grid%ndim
     reach = model%shape%reach_cells(model%grid)
     ! A traction acts at its face centre, up to a particle's size past the particle.
@@ -292,11 +300,14 @@ contains
       lo = 0; hi = 0
       do d = 1, nd
         ! Node c is at origin + c h: a particle in cell c reaches nodes c − reach .. c + 1 + reach.
-        lo(d) = floor((xlo(d) - model%grid%origin(d)) * model%grid%inv_h(d)) - reach
-        hi(d) = floor((xhi(d) - model%grid%origin(d)) * model%grid%inv_h(d)) + 1 + reach
+        lo(d) = floor((xlo(d) - model%grid%gorigin(d)) * model%grid%inv_h(d)) - reach
+        hi(d) = floor((xhi(d) - model%grid%gorigin(d)) * model%grid%inv_h(d)) + 1 + reach
       end do
     end if
     call model%halo%update(model%comm, model%grid, lo, hi, reach)
+    if (.not. model%halo%replan) return
+    call model%fit_window(model%halo%region(:, :, model%comm%rank + 1), moved)
+    call model%halo%plan(model%grid)
   end subroutine share_region
 
   !> Every process takes the failure the serial run would report (that of the particle with
@@ -456,6 +467,9 @@ contains
     call model%halo%sum(model%comm, model%nodes%force)
     if (model%loads%ntraction() > 0) then
       ! The tractions' nodal forces apart (for the residual's ‖f_ext‖), then added.
+      if (size(self%tforce, 2) /= model%nodes%nnode) then ! a new window (parallel runs)
+        deallocate(self%tforce); allocate(self%tforce(d, model%nodes%nnode))
+      end if
       self%tforce = 0.0_wp
       call p2g_tractions(model, t, self%tforce)
       call model%halo%sum(model%comm, self%tforce)
@@ -804,6 +818,11 @@ contains
       end do
     end do
     !$omp end parallel do
+    if (size(integ%vs_mass) /= model%nodes%nnode) then ! a new window (parallel runs)
+      deallocate(integ%vs_mass, integ%vs_q, integ%vs_node)
+      allocate(integ%vs_mass(model%nodes%nnode), integ%vs_q(model%nodes%nnode), &
+               integ%vs_node(d, model%nodes%nnode))
+    end if
     integ%vs_mass = 0.0_wp; integ%vs_q = 0.0_wp
     call p2g_mass(model%basis, model%pts%m(1:np), integ%vs_mass, integ%p2g)
     call p2g_mass(model%basis, integ%vs_w(1:np), integ%vs_q, integ%p2g)

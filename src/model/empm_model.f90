@@ -22,6 +22,10 @@ module empm_model
   integer, parameter :: STEP_SHAPE_FAILED = 1    !! a particle's shape functions failed
   integer, parameter :: STEP_MATERIAL_FAILED = 2 !! a particle's stress update failed
 
+  !> Nodes a window keeps beyond its region on each side, so that it moves only every few
+  !> cells of motion ([[model_fit_window]]).
+  integer, parameter :: WINDOW_SLACK = 4
+
   !> A material and a name for it.
   type :: empm_material_slot_t
     character(len=:), allocatable :: label           !! user label
@@ -40,7 +44,9 @@ module empm_model
 
   !> One simulation.
   type :: empm_model_t
-    type(empm_grid_t) :: grid                           !! background grid
+    type(empm_grid_t) :: grid                           !! background grid; in a parallel run,
+                                                        !! the window of it this process
+                                                        !! stores (`grid%whole()`: all of it)
     type(empm_nodes_t) :: nodes                         !! nodal fields and constraints
     type(empm_particles_t) :: pts                       !! material points
     type(empm_basis_t) :: basis                         !! shape functions at the particles
@@ -48,13 +54,17 @@ module empm_model
     type(empm_material_slot_t), allocatable :: mats(:)  !! materials, indexed by pts%mat
     type(empm_loads_t) :: loads                         !! external loads
     type(empm_comm_t) :: comm                           !! the processes sharing the run: each
-                                                        !! holds its particles, all the grid
+                                                        !! holds its particles and the window
+                                                        !! of the grid they reach
                                                         !! (docs/parallel.md); serial default
     type(empm_halo_t) :: halo                           !! nodal sums over the processes by
                                                         !! neighbour exchange (parallel runs)
     integer, allocatable :: boxes(:,:,:)                !! the processes' boxes of cells,
                                                         !! first and last cell (3, 2, nranks)
     integer, allocatable :: boxes0(:,:,:)               !! the first ones (a static split's)
+    integer :: windows = 0                              !! new windows taken ([[model_fit_window]])
+    integer :: stored_peak = 0                          !! most grid nodes stored at once by
+                                                        !! this process (its windows)
     integer, allocatable :: run_first(:)                !! particle runs with one material: first
     integer, allocatable :: run_last(:)                 !! ... last particle of the run
     real(wp) :: t = 0.0_wp                              !! current time [s]
@@ -82,6 +92,7 @@ module empm_model
   contains
     procedure :: finalize_setup => model_finalize_setup
     procedure :: set_runs => model_set_runs
+    procedure :: fit_window => model_fit_window
   end type empm_model_t
 
 contains
@@ -196,6 +207,41 @@ contains
     end do
     if (nrun > 0) self%run_last(nrun) = np
   end subroutine model_set_runs
+
+  !> Parallel runs: keep the nodal storage on a window of the grid that holds `region`, the
+  !> nodes this process needs (whole-grid 0-based ijk box from [[empm_halo]]; lo > hi: none),
+  !> with WINDOW_SLACK nodes to spare on each side. A new window is taken when the region
+  !> leaves the current one or lies more than 2 WINDOW_SLACK nodes inside one of its faces;
+  !> the nodal fields keep their values on the nodes both windows hold
+  !> ([[empm_nodes_t:window]]). `moved`: the stored grid changed (its node numbers with it).
+  !> The basis holds node numbers: call before evaluating it.
+  subroutine model_fit_window(self, region, moved)
+    class(empm_model_t), intent(inout) :: self !! model
+    integer, intent(in) :: region(3, 2)        !! the nodes this process needs
+    logical, intent(out) :: moved              !! a new window was taken
+    type(empm_grid_t) :: new
+    integer :: nd, need(3, 2), lim(3, 2), cur(3, 2)
+    nd = self%grid%ndim
+    need = 0; lim = 0
+    if (all(region(1:nd, 1) <= region(1:nd, 2))) then
+      need(1:nd, :) = region(1:nd, :)
+      lim(1:nd, 1) = max(region(1:nd, 1) - 2 * WINDOW_SLACK, 0)
+      lim(1:nd, 2) = min(region(1:nd, 2) + 2 * WINDOW_SLACK, self%grid%gnn(1:nd) - 1)
+    end if
+    cur(:, 1) = self%grid%off; cur(:, 2) = self%grid%off + self%grid%nn - 1
+    moved = .not. all(cur(1:nd, 1) <= need(1:nd, 1) .and. cur(1:nd, 2) >= need(1:nd, 2) .and. &
+                      cur(1:nd, 1) >= lim(1:nd, 1) .and. cur(1:nd, 2) <= lim(1:nd, 2))
+    if (.not. moved) return
+    if (all(region(1:nd, 1) <= region(1:nd, 2))) then
+      new = self%grid%window(need(:, 1) - WINDOW_SLACK, need(:, 2) + WINDOW_SLACK)
+    else
+      new = self%grid%window(need(:, 1), need(:, 1)) ! no particle: one node
+    end if
+    call self%nodes%window(self%grid, new)
+    self%grid = new
+    self%windows = self%windows + 1
+    self%stored_peak = max(self%stored_peak, new%nnode)
+  end subroutine model_fit_window
 
   !> A material's state variables must have as many names as `nstate`, each made of letters,
   !> digits and '_' (they name HDF5 datasets and XDMF attributes), without repeats.

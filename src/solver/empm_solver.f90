@@ -8,6 +8,7 @@ module empm_solver
                         EMPM_ERR_RUNTIME, EMPM_ERR_USAGE, EMPM_ERR_INTERRUPTED
   use empm_strings, only: str, join
   use empm_partition, only: empm_rebalance, empm_share_traction_state
+  use empm_grid, only: empm_grid_t
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK, STEP_SHAPE_FAILED
   use empm_loads, only: RAMP_NONE
   use empm_integrator, only: empm_integrator_t
@@ -103,6 +104,10 @@ module empm_solver
     real(wp) :: halo_bytes = 0.0_wp     !! bytes of nodal partial sums the busiest process
                                         !! sent per step to its neighbours
     integer :: migrated = 0             !! particles that changed process at the re-cuts
+    integer :: grid_nodes = 0           !! nodes of the whole grid
+    integer :: stored_nodes = 0         !! most grid nodes a process stored at once (its
+                                        !! window; parallel runs)
+    integer :: windows = 0              !! new windows taken, all processes together
   end type empm_run_stats_t
 
 contains
@@ -537,6 +542,7 @@ contains
 
     ! The statistics of the run so far (the model holds the last good state).
     subroutine finish_stats()
+      type(empm_grid_t) :: whole
       call system_clock(clock)
       st%wall = real(clock - clock0, wp) / real(rate, wp)
       if (st%steps == 0) st%dt_min = 0.0_wp
@@ -545,6 +551,10 @@ contains
       call empm_energies(model, psi, ekin, estr, egrav)
       st%energy_final = ekin + estr + egrav
       st%halo_bytes = model%comm%max_real(real(model%halo%sent - sent0, wp) / max(st%steps, 1))
+      whole = model%grid%whole()
+      st%grid_nodes = whole%nnode
+      st%stored_nodes = nint(model%comm%max_real(real(model%stored_peak, wp)))
+      st%windows = model%comm%sum_int(model%windows)
       if (present(stats)) stats = st
     end subroutine finish_stats
 
@@ -712,8 +722,9 @@ contains
       end do
     end associate
     do k = 1, nd
-      upper = model%grid%origin(k) + model%grid%ncell(k) * model%grid%h(k)
-      if (np > 0 .and. .not. (lo(k) >= model%grid%origin(k) .and. hi(k) <= upper)) return
+      ! The whole grid's box (a parallel process stores a window of it).
+      upper = model%grid%gorigin(k) + (model%grid%gnn(k) - 1) * model%grid%h(k)
+      if (np > 0 .and. .not. (lo(k) >= model%grid%gorigin(k) .and. hi(k) <= upper)) return
     end do
     do I = 1, model%nodes%nplane
       k = abs(model%nodes%plane_side(I))
@@ -959,7 +970,8 @@ contains
         trim(adjustl(e1))//')'
       write(e0, '(es10.3)') st%halo_bytes
       s = s//', '//str(st%migrated)//' particles migrated, halo '//trim(adjustl(e0))// &
-        ' bytes per step'
+        ' bytes per step, grid nodes stored per process at most '//str(st%stored_nodes)// &
+        ' of '//str(st%grid_nodes)//' ('//str(st%windows)//' windows)'
     end if
   end function empm_run_summary
 

@@ -55,6 +55,7 @@ module empm_transfer
   contains
     procedure :: init => p2g_work_init
     procedure :: set_ranges => p2g_work_set_ranges
+    procedure :: fit => p2g_work_fit
   end type empm_p2g_work_t
 
   ! What a P2G pass accumulates: the selector of [[p2g_drive]] and [[p2g_range]].
@@ -83,6 +84,20 @@ contains
     self%lo = 1; self%hi = 0; self%slo = 1; self%shi = 0
     self%two_phase = .false.
   end subroutine p2g_work_init
+
+  !> Resize the per-thread accumulators for `nnode` nodes when the stored grid changed size (a
+  !> parallel process's new window); nothing otherwise.
+  subroutine p2g_work_fit(self, nnode)
+    class(empm_p2g_work_t), intent(inout) :: self !! workspace
+    integer, intent(in) :: nnode                  !! nodes of the stored grid
+    integer :: nd
+    if (self%nt <= 1 .or. .not. allocated(self%buf)) return
+    if (size(self%buf, 2) == nnode) return
+    nd = size(self%buf, 1)
+    deallocate(self%buf, self%mbuf)
+    allocate(self%buf(nd, nnode, self%nt - 1), self%mbuf(nnode, self%nt - 1))
+    self%buf = 0.0_wp; self%mbuf = 0.0_wp
+  end subroutine p2g_work_fit
 
   !> Record the node range touched by each particle sub-chunk and chunk for the current basis
   !> and choose the mode (two phases when sub-chunks k and k + 2 share no node). The basis
