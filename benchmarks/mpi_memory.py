@@ -7,6 +7,7 @@ the median of the samples over the last half of the run (the time loop), and the
 line's grid nodes stored per process.
 
 Usage: mpi_memory.py EMPM MPIRUN WORKDIR [--ranks 1,2,4] [--cells 96] [--steps 40]
+       [--shape linear|lme]   (lme: gamma = 1.8, whose basis outweighs the particles)
 Prints one line per run and a JSON line per run.
 """
 import json
@@ -35,7 +36,7 @@ CASE = """&grid
   material = 'soil', geometry = 'box', lo = {a}, {a}, 0.0, hi = {b}, {b}, {top}, ppc = 2
 /
 &shape
-  family = 'linear'
+  family = {shape}
 /
 &integrator
   scheme = 'pc_newmark', cfl = 0.5, t_end = {t_end}
@@ -81,6 +82,7 @@ def main():
     empm, mpirun, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
     ranks = [int(k) for k in opt("--ranks", "1,2,4").split(",")]
     n, steps = opt("--cells", 96), opt("--steps", 40)
+    shape = {"linear": "'linear'", "lme": "'lme', gamma = 1.8"}[opt("--shape", "linear")]
     work.mkdir(parents=True, exist_ok=True)
     h = 0.05
     L = n * h
@@ -90,7 +92,8 @@ def main():
     top = round(nz * h / 3.0, 6)
     dt = 0.5 * h / (1.0e6 * 0.7 / (1.3 * 0.4) / 2000.0) ** 0.5
     path = work / "column.nml"
-    path.write_text(CASE.format(h=h, n=n, nz=nz, a=a, b=b, top=top, L=L, t_end=steps * dt))
+    path.write_text(CASE.format(h=h, n=n, nz=nz, a=a, b=b, top=top, L=L, t_end=steps * dt,
+                               shape=shape))
     exe = os.path.realpath(empm)
     env = dict(os.environ, OMP_NUM_THREADS="1")
     mpi = [mpirun, "--oversubscribe"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
@@ -122,7 +125,7 @@ def main():
         print(f"{r} process(es): peak {[p['peak_mb'] for p in per]} MB, time loop "
               f"{[p['time_loop_mb'] for p in per]} MB, grid nodes stored "
               f"{stored[0] if stored else 'all'} of {stored[1] if stored else 'all'}", flush=True)
-        print(json.dumps({"tag": "mpi_memory", "ranks": r, "cells": [n, n, nz],
+        print(json.dumps({"tag": "mpi_memory", "ranks": r, "cells": [n, n, nz], "shape": shape,
                           "processes": per, "stored_nodes": stored}))
     return 0
 

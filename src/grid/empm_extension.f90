@@ -168,9 +168,12 @@ contains
     end do
   contains
     ! Stencil nodes are free: a degenerate node next to a prescribed boundary (a footing, a
-    ! wall) must not be tied to the boundary's motion.
+    ! wall) must not be tied to the boundary's motion. Node 0: not stored (beyond a parallel
+    ! process's window, where its particles read nothing).
     logical function usable(node)
       integer, intent(in) :: node
+      usable = .false.
+      if (node == 0) return
       usable = mass(node) > mass_tol .and. .not. self%deg(node) .and. .not. any(fixed(:, node))
     end function usable
   end subroutine ext_find

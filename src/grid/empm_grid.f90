@@ -3,17 +3,20 @@
 !> Nodes are numbered lexicographically, x fastest: node (i,j,k), 0-based per direction,
 !> has index `1 + i + n1*(j + n2*k)` with `n1, n2` the node counts along x and y.
 !>
-!> A grid may be a **window** of a larger one: the box of nodes a process of a parallel run
-!> stores (docs/parallel.md, "Block-local grids"). Its nodes are numbered as above within the
-!> window, `off` places it in the whole grid, and `inside`, `upper` and `whole` answer for
-!> the whole grid. A grid made by `init` is its own whole grid.
+!> A grid may store only a **window** of its nodes: the box a process of a parallel run holds
+!> (docs/parallel.md, "Block-local grids"). Its geometry (origin, spacing, cell and node
+!> counts, `inside`, `node_coord`, node (i,j,k)) stays the whole grid's, so every coordinate a
+!> window computes is the serial run's to the bit; only node ids are the window's: node (i,j,k)
+!> has index `id0 + i + l1*(j + l2*k)` with `l1, l2` the window's node counts and `id0` placing
+!> its first node at 1. `node_id` returns 0 for a node outside the window. A grid made by `init`
+!> stores all its nodes.
 module empm_grid
   use empm_kinds, only: wp, int64 => i8
   implicit none
   private
   public :: empm_grid_t
 
-  !> Background grid: origin, spacing and cell counts.
+  !> Background grid: origin, spacing and cell counts, and the box of nodes it stores.
   type :: empm_grid_t
     integer :: ndim = 0                !! spatial dimension (1, 2 or 3)
     real(wp) :: origin(3) = 0.0_wp     !! coordinates of node (0,0,0)
@@ -21,11 +24,11 @@ module empm_grid
     real(wp) :: inv_h(3) = 1.0_wp      !! 1/h per direction
     integer :: ncell(3) = 1            !! cells per direction (1 along unused directions)
     integer :: nn(3) = 1               !! nodes per direction (1 along unused directions)
-    integer :: nnode = 0               !! total number of nodes
-    integer :: off(3) = 0              !! window: the whole grid's 0-based (i,j,k) of this
-                                       !! grid's node (0,0,0); 0 for a whole grid
-    integer :: gnn(3) = 1              !! the whole grid's nodes per direction
-    real(wp) :: gorigin(3) = 0.0_wp    !! the whole grid's origin
+    integer :: nnode = 0               !! number of nodes stored (all, or the window's)
+    integer :: off(3) = 0              !! (i,j,k) of the first node stored (0 unless a window)
+    integer :: ln(3) = 1               !! nodes stored per direction (nn unless a window)
+    integer :: id0 = 1                 !! index of node (0,0,0) in the stored numbering:
+                                       !! 1 − off1 − l1 (off2 + l2 off3)
   contains
     procedure :: init => grid_init
     procedure :: node_coord => grid_node_coord
@@ -36,7 +39,6 @@ module empm_grid
     procedure :: upper => grid_upper
     procedure :: window => grid_window
     procedure :: whole => grid_whole
-    procedure :: local_id => grid_local_id
   end type empm_grid_t
 
 contains
@@ -72,10 +74,10 @@ contains
     self%ncell(1:ndim) = ncell(1:ndim)
     self%nn(1:ndim) = ncell(1:ndim) + 1
     self%nnode = product(self%nn)
-    self%off = 0; self%gnn = self%nn; self%gorigin = self%origin
+    self%off = 0; self%ln = self%nn; self%id0 = 1
   end subroutine grid_init
 
-  !> Coordinates of node `id` (first `ndim` entries meaningful, others 0).
+  !> Coordinates of stored node `id` (first `ndim` entries meaningful, others 0).
   pure function grid_node_coord(self, id) result(x)
     class(empm_grid_t), intent(in) :: self !! grid
     integer, intent(in) :: id              !! node index, 1..nnode
@@ -86,37 +88,39 @@ contains
     x(self%ndim + 1:) = 0.0_wp
   end function grid_node_coord
 
-  !> Node index from 0-based (i,j,k); 0 if outside the grid.
+  !> Index of node (i,j,k) (0-based) among the stored nodes; 0 if outside the grid or not
+  !> stored (outside the window).
   pure integer function grid_node_id(self, ijk) result(id)
     class(empm_grid_t), intent(in) :: self !! grid
     integer, intent(in) :: ijk(3)          !! 0-based indices (unused directions: 0)
-    if (any(ijk < 0) .or. any(ijk >= self%nn)) then
+    if (any(ijk < self%off) .or. any(ijk >= self%off + self%ln)) then
       id = 0
     else
-      id = 1 + ijk(1) + self%nn(1) * (ijk(2) + self%nn(2) * ijk(3))
+      id = self%id0 + ijk(1) + self%ln(1) * (ijk(2) + self%ln(2) * ijk(3))
     end if
   end function grid_node_id
 
-  !> 0-based (i,j,k) of node `id`.
+  !> 0-based (i,j,k) of stored node `id`.
   pure function grid_node_ijk(self, id) result(ijk)
     class(empm_grid_t), intent(in) :: self !! grid
     integer, intent(in) :: id              !! node index, 1..nnode
     integer :: ijk(3)                      !! 0-based indices
     integer :: r
     r = id - 1
-    ijk(1) = mod(r, self%nn(1)); r = r / self%nn(1)
-    ijk(2) = mod(r, self%nn(2)); ijk(3) = r / self%nn(2)
+    ijk(1) = mod(r, self%ln(1)); r = r / self%ln(1)
+    ijk(2) = mod(r, self%ln(2)); ijk(3) = r / self%ln(2)
+    ijk = ijk + self%off
   end function grid_node_ijk
 
-  !> True when `x` lies in the closed box of the whole grid.
+  !> True when `x` lies in the closed grid box.
   pure logical function grid_inside(self, x) result(inside)
     class(empm_grid_t), intent(in) :: self !! grid
     real(wp), intent(in) :: x(:)           !! point, `ndim` entries
     integer :: d
     inside = .true.
     do d = 1, self%ndim
-      if (.not. (x(d) >= self%gorigin(d) .and. &
-                 x(d) <= self%gorigin(d) + (self%gnn(d) - 1) * self%h(d))) inside = .false.
+      if (.not. (x(d) >= self%origin(d) .and. &
+                 x(d) <= self%origin(d) + self%ncell(d) * self%h(d))) inside = .false.
     end do
   end function grid_inside
 
@@ -126,49 +130,39 @@ contains
     hm = minval(self%h(1:self%ndim))
   end function grid_hmin
 
-  !> Upper corner of the whole grid's box.
+  !> Upper corner of the grid box.
   pure function grid_upper(self) result(x)
     class(empm_grid_t), intent(in) :: self !! grid
     real(wp) :: x(3) !! upper corner (unused directions: 0)
     x = 0.0_wp
-    x(1:self%ndim) = self%gorigin(1:self%ndim) + (self%gnn(1:self%ndim) - 1) * self%h(1:self%ndim)
+    x(1:self%ndim) = self%origin(1:self%ndim) + self%ncell(1:self%ndim) * self%h(1:self%ndim)
   end function grid_upper
 
-  !> The window of the whole grid holding its nodes lo..hi (0-based (i,j,k), clipped to the
-  !> whole grid; unused directions ignored). Its origin is the whole grid's plus lo h.
+  !> The grid storing only its nodes lo..hi (0-based (i,j,k), clipped to the grid; unused
+  !> directions ignored): a window.
   pure function grid_window(self, lo, hi) result(w)
-    class(empm_grid_t), intent(in) :: self !! grid (whole or a window of it)
-    integer, intent(in) :: lo(3)           !! first node, whole-grid (i,j,k)
-    integer, intent(in) :: hi(3)           !! last node
+    class(empm_grid_t), intent(in) :: self !! grid
+    integer, intent(in) :: lo(3)           !! first node stored
+    integer, intent(in) :: hi(3)           !! last node stored
     type(empm_grid_t) :: w                 !! the window
     integer :: nd, a(3), b(3)
     nd = self%ndim
     a = 0; b = 0
-    a(1:nd) = max(lo(1:nd), 0); b(1:nd) = min(hi(1:nd), self%gnn(1:nd) - 1)
+    a(1:nd) = max(lo(1:nd), 0); b(1:nd) = min(hi(1:nd), self%nn(1:nd) - 1)
     b = max(a, b)
     w = self
     w%off = a
-    w%nn = b - a + 1
-    w%ncell = 0; w%ncell(1:nd) = w%nn(1:nd) - 1
-    w%nnode = product(w%nn)
-    w%origin = self%gorigin
-    w%origin(1:nd) = self%gorigin(1:nd) + a(1:nd) * self%h(1:nd)
+    w%ln = b - a + 1
+    w%nnode = product(w%ln)
+    w%id0 = 1 - a(1) - w%ln(1) * (a(2) + w%ln(2) * a(3))
   end function grid_window
 
-  !> The whole grid this grid is a window of (itself when it is whole).
+  !> The grid storing all its nodes (itself unless a window).
   pure function grid_whole(self) result(g)
     class(empm_grid_t), intent(in) :: self !! grid
     type(empm_grid_t) :: g                 !! the whole grid
     g = self
-    g%off = 0; g%nn = self%gnn; g%origin = self%gorigin
-    g%ncell = 0; g%ncell(1:self%ndim) = self%gnn(1:self%ndim) - 1
+    g%off = 0; g%ln = self%nn; g%id0 = 1
     g%nnode = product(g%nn)
   end function grid_whole
-
-  !> This grid's index of the whole grid's node (i,j,k) (0-based); 0 outside the window.
-  pure integer function grid_local_id(self, gijk) result(id)
-    class(empm_grid_t), intent(in) :: self !! grid
-    integer, intent(in) :: gijk(3)         !! whole-grid indices (unused directions: 0)
-    id = self%node_id(gijk - self%off)
-  end function grid_local_id
 end module empm_grid

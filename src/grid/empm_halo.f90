@@ -93,8 +93,8 @@ contains
       end if
     end if
     self%last(:, 1) = lo; self%last(:, 2) = hi
-    c(:, 1) = max(c(:, 1), 0); c(:, 2) = min(c(:, 2), grid%gnn - 1)
-    r(:, 1) = max(c(:, 1) - self%margin, 0); r(:, 2) = min(c(:, 2) + self%margin, grid%gnn - 1)
+    c(:, 1) = max(c(:, 1), 0); c(:, 2) = min(c(:, 2), grid%nn - 1)
+    r(:, 1) = max(c(:, 1) - self%margin, 0); r(:, 2) = min(c(:, 2) + self%margin, grid%nn - 1)
     if (any(c(:, 1) > c(:, 2))) then
       c(:, 1) = 0; c(:, 2) = -1; r = c
     end if
@@ -256,8 +256,7 @@ contains
       do j = b(2, 1), b(2, 2)
         do i = b(1, 1), b(1, 2)
           e = e + 1
-          ids(e) = 1 + (i - grid%off(1)) + grid%nn(1) * ((j - grid%off(2)) + &
-                                                         grid%nn(2) * (k - grid%off(3)))
+          ids(e) = grid%id0 + i + grid%ln(1) * (j + grid%ln(2) * k)
         end do
       end do
     end do
@@ -272,7 +271,7 @@ contains
     integer :: ijk(3)
     yes = .true.
     if (.not. self%active) return
-    ijk = grid%node_ijk(id) + grid%off
+    ijk = grid%node_ijk(id)
     yes = all(ijk >= self%core(:, 1, self%me + 1) .and. ijk <= self%core(:, 2, self%me + 1))
   end function halo_in_core
 

@@ -117,7 +117,7 @@ contains
     n = new%nnode; nd = self%ndim
     allocate(from(n))
     do I = 1, n
-      from(I) = old%local_id(new%node_ijk(I) + new%off)
+      from(I) = old%node_id(new%node_ijk(I))
     end do
     call move1(self%mass); call move1(self%vol)
     call move2(self%mom); call move2(self%vel); call move2(self%force); call move2(self%acc)
@@ -150,8 +150,8 @@ contains
     allocate(gh(size(self%cat%ghost)), im(size(self%cat%ghost)), keep(size(self%cat%ghost)))
     j = 0
     do k = 1, size(self%cat%ghost)
-      gh(k) = new%local_id(whole%node_ijk(self%cat%ghost(k)))
-      im(k) = new%local_id(whole%node_ijk(self%cat%image(k)))
+      gh(k) = new%node_id(whole%node_ijk(self%cat%ghost(k)))
+      im(k) = new%node_id(whole%node_ijk(self%cat%image(k)))
       if (gh(k) == 0 .or. im(k) == 0) cycle
       j = j + 1; keep(j) = k
     end do
@@ -162,7 +162,7 @@ contains
     ! Frictional wall nodes in the window.
     call self%fric%init(nd)
     do k = 1, self%cat%fric%n
-      L = new%local_id(whole%node_ijk(self%cat%fric%node(k)))
+      L = new%node_id(whole%node_ijk(self%cat%fric%node(k)))
       if (L == 0) cycle
       call self%fric%add([L], self%cat%fric%axis(k), self%cat%fric%sgn(k), self%cat%fric%mu(k), &
                          self%cat%fric%set(k))
@@ -173,19 +173,23 @@ contains
     integer function local_dof(gj)
       integer, intent(in) :: gj
       integer :: id
-      id = new%local_id(whole%node_ijk((gj - 1) / nd + 1))
+      id = new%node_id(whole%node_ijk((gj - 1) / nd + 1))
       local_dof = 0
       if (id > 0) local_dof = mod(gj - 1, nd) + 1 + nd * (id - 1)
     end function local_dof
 
+    ! A field on the new window: the old values where both hold the node (none when the
+    ! fields were never allocated: set-up's storage, [[nodes_alloc]]), else 0.
     subroutine move1(a)
       real(wp), allocatable, intent(inout) :: a(:)
       real(wp), allocatable :: b(:)
       integer :: q
+      logical :: had
+      had = size(a) == old%nnode
       allocate(b(n))
       do q = 1, n
         b(q) = 0.0_wp
-        if (from(q) > 0) b(q) = a(from(q))
+        if (had .and. from(q) > 0) b(q) = a(from(q))
       end do
       call move_alloc(b, a)
     end subroutine move1
@@ -194,10 +198,12 @@ contains
       real(wp), allocatable, intent(inout) :: a(:,:)
       real(wp), allocatable :: b(:,:)
       integer :: q
-      allocate(b(size(a, 1), n))
+      logical :: had
+      had = size(a, 2) == old%nnode
+      allocate(b(nd, n))
       do q = 1, n
         b(:, q) = 0.0_wp
-        if (from(q) > 0) b(:, q) = a(:, from(q))
+        if (had .and. from(q) > 0) b(:, q) = a(:, from(q))
       end do
       call move_alloc(b, a)
     end subroutine move2
@@ -207,7 +213,7 @@ contains
   subroutine make_catalogue(self, whole)
     type(empm_nodes_t), intent(inout) :: self
     type(empm_grid_t), intent(in) :: whole
-    if (any(whole%off /= 0) .or. any(whole%nn /= whole%gnn)) &
+    if (any(whole%off /= 0) .or. any(whole%ln /= whole%nn)) &
       error stop 'empm_nodes: the first window must be taken from the whole grid'
     self%cat%fix = self%fixed_dofs
     self%cat%vfix = pack(self%vfix, self%fixed)
@@ -219,23 +225,32 @@ contains
   end subroutine make_catalogue
 
   !> Allocate nodal storage for `grid`; no dof fixed. An allocation failure is reported in
-  !> `err` when present (with the memory asked for), otherwise it stops the program.
-  subroutine nodes_alloc(self, grid, err)
+  !> `err` when present (with the memory asked for), otherwise it stops the program. With
+  !> `fields = .false.` only the constraints are stored (the boundaries can be set) and the
+  !> fields are empty until a window is taken ([[nodes_window]]): a parallel run's set-up,
+  !> which never holds the whole grid's fields.
+  subroutine nodes_alloc(self, grid, err, fields)
     class(empm_nodes_t), intent(inout) :: self     !! nodal fields
     type(empm_grid_t), intent(in) :: grid          !! background grid
     type(empm_error_t), intent(inout), optional :: err !! set on an allocation failure
-    integer :: d, n, stat
+    logical, intent(in), optional :: fields        !! allocate the fields (default .true.)
+    integer :: d, n, nf, stat
     character(len=256) :: msg
     d = grid%ndim; n = grid%nnode
+    nf = n
+    if (present(fields)) then
+      if (.not. fields) nf = 0
+    end if
     self%ndim = d; self%nnode = n
     if (allocated(self%mass)) deallocate(self%mass, self%mom, self%vel, self%force, self%acc, &
       self%work, self%fixed, self%vfix, self%vol)
-    allocate(self%mass(n), self%mom(d, n), self%vel(d, n), self%force(d, n), self%acc(d, n), &
-      self%work(d, n), self%fixed(d, n), self%vfix(d, n), self%vol(n), stat=stat, errmsg=msg)
+    allocate(self%mass(nf), self%mom(d, nf), self%vel(d, nf), self%force(d, nf), &
+      self%acc(d, nf), self%work(d, nf), self%fixed(d, n), self%vfix(d, n), self%vol(nf), &
+      stat=stat, errmsg=msg)
     if (stat /= 0) then
       self%nnode = 0
       call empm_raise_error(empm_alloc_error('nodal fields ('//str(n)//' nodes)', &
-        int(n, int64) * (8_int64 + 7_int64 * 8_int64 * d), msg), err)
+        int(nf, int64) * 8_int64 * (2 + 5 * d) + int(n, int64) * 12_int64 * d, msg), err)
       return
     end if
     self%fixed = .false.; self%vfix = 0.0_wp
@@ -247,10 +262,10 @@ contains
     allocate(self%set_name(0), self%set_ptr(1), self%set_dof(0), self%set_fix(d, 0), &
       self%set_vel(d, 0), self%reaction(d, 0))
     self%set_ptr(1) = 1
-    call zero(self%mass, n); call zero(self%mom, d * n); call zero(self%vel, d * n)
-    call zero(self%force, d * n); call zero(self%acc, d * n); call zero(self%work, d * n)
-    call zero(self%vol, n)
-    call self%ext%init(n)
+    call zero(self%mass, nf); call zero(self%mom, d * nf); call zero(self%vel, d * nf)
+    call zero(self%force, d * nf); call zero(self%acc, d * nf); call zero(self%work, d * nf)
+    call zero(self%vol, nf)
+    call self%ext%init(nf)
     call self%fric%init(d)
     self%nmirror = 0; self%nplane = 0
     if (allocated(self%ghost)) deallocate(self%ghost, self%image, self%msign, self%plane_side, &

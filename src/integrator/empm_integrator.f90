@@ -134,6 +134,9 @@ contains
         'frictional walls ('//WALL_SCHEMES//' do)', err)
       return
     end if
+    ! A case read to be shared among processes gets its nodal fields with its first window
+    ! of the grid; one that was not shared gets them here, on the grid it stores.
+    if (size(model%nodes%mass) /= model%nodes%nnode) call model%nodes%window(model%grid, model%grid)
     if (allocated(self%bwork)) deallocate(self%bwork)
     allocate(self%bwork(model%grid%ndim, model%pts%np), stat=stat, errmsg=msg)
     if (stat /= 0) then
@@ -256,7 +259,7 @@ contains
     ! The nodes the particles reach, and the window of the grid stored for them, come first:
     ! the basis is numbered on that window.
     if (model%comm%parallel()) then
-      call share_region(model)
+      call model%share_region()
       if (present(ws)) call ws%fit(model%grid%nnode)
     end if
     if (present(timer)) then
@@ -274,41 +277,6 @@ contains
     end if
     call agree_status(model, stat)
   end subroutine eval_basis
-
-  !> Parallel runs: the nodes this process's particles reach at their current positions (the
-  !> box of their cells widened by the family's reach), agreed with the other processes
-  !> ([[empm_halo]]); when the boxes changed, the stored window of the grid is fitted to this
-  !> process's region ([[empm_model_t:fit_window]]) and the exchange plan rebuilt on it.
-  subroutine share_region(model)
-    type(empm_model_t), intent(inout) :: model !! simulation state
-    real(wp) :: xlo(3), xhi(3)
-    integer :: lo(3), hi(3), d, p, nd, reach
-    logical :: moved
-    nd = model%grid%ndim
-    reach = model%shape%reach_cells(model%grid)
-    ! A traction acts at its face centre, up to a particle's size past the particle.
-    if (model%loads%ntraction() > 0) reach = reach + 1
-    lo = 0; hi = -1
-    if (model%pts%np > 0) then
-      xlo = 0.0_wp; xhi = 0.0_wp
-      do d = 1, nd
-        xlo(d) = huge(1.0_wp); xhi(d) = -huge(1.0_wp)
-        do p = 1, model%pts%np
-          xlo(d) = min(xlo(d), model%pts%x(d, p)); xhi(d) = max(xhi(d), model%pts%x(d, p))
-        end do
-      end do
-      lo = 0; hi = 0
-      do d = 1, nd
-        ! Node c is at origin + c h: a particle in cell c reaches nodes c − reach .. c + 1 + reach.
-        lo(d) = floor((xlo(d) - model%grid%gorigin(d)) * model%grid%inv_h(d)) - reach
-        hi(d) = floor((xhi(d) - model%grid%gorigin(d)) * model%grid%inv_h(d)) + 1 + reach
-      end do
-    end if
-    call model%halo%update(model%comm, model%grid, lo, hi, reach)
-    if (.not. model%halo%replan) return
-    call model%fit_window(model%halo%region(:, :, model%comm%rank + 1), moved)
-    call model%halo%plan(model%grid)
-  end subroutine share_region
 
   !> Every process takes the failure the serial run would report (that of the particle with
   !> the smallest id), or none: the processes leave a step together, before its next

@@ -5,7 +5,7 @@ module empm_driver
   use empm_error, only: empm_error_t, empm_raise_error, EMPM_OK, EMPM_ERR_INTERRUPTED, &
                         EMPM_ERR_INPUT
   use empm_case, only: empm_case_t
-  use empm_input, only: empm_read_case
+  use empm_input, only: empm_read_case, empm_check_basis
   use empm_model, only: empm_model_t
   use empm_history, only: empm_history_t
   use empm_solver, only: empm_solve, empm_run_stats_t, empm_run_hook_t, empm_solver_state_t
@@ -164,11 +164,17 @@ contains
     type(empm_history_t) :: hist
     type(empm_error_t) :: e, ew
     type(empm_output_meta_t) :: meta
-    logical :: add0
+    logical :: add0, shared
     type(empm_cpu_sample_t) :: load0
 
     call empm_cpu_sample(load0)
-    call empm_read_case(path, cs, e, extra_groups=extra_groups)
+    ! Shared among processes, the case waits for each one's share of the particles to store
+    ! its window of the grid and its basis (a restart replaces the particles: it is set up
+    ! whole, as before).
+    shared = .false.
+    if (present(comm) .and. present(restart)) shared = comm%parallel() .and. len_trim(restart) == 0
+    if (present(comm) .and. .not. present(restart)) shared = comm%parallel()
+    call empm_read_case(path, cs, e, extra_groups=extra_groups, shared=shared)
     ! Each process reads the case: one that cannot (a file missing on its machine) must not
     ! leave the others waiting. All take the error of the first process that has one.
     if (present(comm)) call empm_agree_error(comm, e)
@@ -222,6 +228,10 @@ contains
     end if
     if (cs%model%comm%parallel()) then
       call empm_partition_particles(cs%model, e, hist)
+      if (e%code == EMPM_OK .and. shared) then
+        call empm_check_basis(path, cs, e)
+        call empm_agree_error(cs%model%comm, e)
+      end if
       if (e%code /= EMPM_OK) then
         call release(); call empm_raise_error(e, err); return
       end if

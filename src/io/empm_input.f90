@@ -32,7 +32,7 @@ module empm_input
   use empm_bodies, only: empm_body_points_t, empm_read_body, empm_body_path
   implicit none
   private
-  public :: empm_read_case, empm_input_markdown, empm_input_group_params
+  public :: empm_read_case, empm_input_markdown, empm_input_group_params, empm_check_basis
 
   character(len=*), parameter :: GROUPS = 'grid material particles shape integrator loads '// &
                                           'traction boundary probe output'
@@ -250,18 +250,26 @@ contains
   !> Read, validate and set up the case in `path`. On error, `err` (or a stop with status 2)
   !> names the file, the line, the group and the key. `extra_groups` (blank-separated) are
   !> groups the caller reads itself (e.g. 'verify'): they are skipped, not rejected.
-  subroutine empm_read_case(path, cs, err, overrides, registry, extra_groups)
+  subroutine empm_read_case(path, cs, err, overrides, registry, extra_groups, shared)
     character(len=*), intent(in) :: path                      !! case file
     type(empm_case_t), intent(inout) :: cs                    !! the case, ready to run
     type(empm_error_t), intent(out), optional :: err          !! error, if present
     type(empm_overrides_t), intent(in), optional :: overrides !! changes to the file's values
     type(empm_registry_t), intent(in), optional :: registry   !! families (default: built-ins)
     character(len=*), intent(in), optional :: extra_groups    !! groups read by the caller
+    logical, intent(in), optional :: shared                   !! the case will be shared among
+                                                              !! processes: the nodal fields
+                                                              !! wait for each one's window of
+                                                              !! the grid, the basis and its
+                                                              !! check ([[empm_check_basis]])
+                                                              !! for each one's share
+                                                              !! (docs/parallel.md)
     type(empm_overrides_t) :: ov
     type(empm_registry_t) :: reg
     type(empm_group_t), allocatable :: gs(:)
     type(empm_error_t) :: e
     character(len=:), allocatable :: extra
+    logical :: fields
 
     cs = empm_case_t()  ! a case object may be read into again
     if (present(overrides)) ov = overrides
@@ -287,14 +295,17 @@ contains
     if (e%code == EMPM_OK) call read_integrator(path, gs, cs, ov, reg, e)
     if (e%code == EMPM_OK) call read_loads(gs, cs, e)
     if (e%code == EMPM_OK) call apply_geostatic(gs, cs, e)
-    if (e%code == EMPM_OK) call read_boundaries(gs, cs, e)
+    fields = .true.
+    if (present(shared)) fields = .not. shared
+    if (e%code == EMPM_OK) call read_boundaries(gs, cs, fields, e)
     if (e%code == EMPM_OK) call read_tractions(gs, cs, e)
     if (e%code == EMPM_OK) cs%model%track = cs%integ%damping > 0.0_wp .or. &
       any(cs%body_k0 >= 0.0_wp) .or. cs%model%loads%ntraction() > 0 .or. &
       cs%model%nodes%nset > 0
     if (e%code == EMPM_OK) call read_probes(gs, cs, e)
     if (e%code == EMPM_OK) call read_output(path, gs, cs, e)
-    if (e%code == EMPM_OK) call check_initial_basis(path, cs, e)
+    if (e%code == EMPM_OK) call cs%model%finalize_setup(e, shared=.not. fields)
+    if (e%code == EMPM_OK .and. fields) call check_basis(path, cs, e)
     call empm_raise_error(e, err)
   end subroutine empm_read_case
 
@@ -846,9 +857,10 @@ contains
     end if
   end subroutine read_loads
 
-  subroutine read_boundaries(gs, cs, e)
+  subroutine read_boundaries(gs, cs, fields, e)
     type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
+    logical, intent(in) :: fields
     type(empm_error_t), intent(inout) :: e
     type(empm_param_t), allocatable :: p(:)
     type(empm_group_t) :: g
@@ -858,7 +870,7 @@ contains
     character(len=:), allocatable :: name, mirror
     allocate(p, source=empm_input_group_params('boundary'))
     nd = cs%model%grid%ndim
-    call cs%model%nodes%alloc(cs%model%grid)
+    call cs%model%nodes%alloc(cs%model%grid, fields=fields)
     nb = 0
     do k = 1, size(gs)
       if (gs(k)%name /= 'boundary') cycle
@@ -1288,16 +1300,36 @@ contains
     out = path(s + 1:d - 1)//'.h5'
   end function default_output
 
-  !> Finish the set-up and evaluate the shape functions once: a particle whose support does not
-  !> fit the grid is an input error, reported before any step is taken.
-  subroutine check_initial_basis(path, cs, e)
+  !> Evaluate the shape functions once at the particles a process holds, after a case read
+  !> with `shared` has been shared among the processes (`empm_partition_particles`): what
+  !> [[empm_read_case]] does for a serial run. A particle whose support does not fit the grid
+  !> is an input error (exit 2), reported before any step is taken; under several processes
+  !> every process reports the serial run's error, that of the particle with the smallest id.
+  !> Collective.
+  subroutine empm_check_basis(path, cs, err)
+    character(len=*), intent(in) :: path                !! case file (for the message)
+    type(empm_case_t), intent(inout) :: cs              !! the case, shared
+    type(empm_error_t), intent(out), optional :: err    !! error, if present
+    type(empm_error_t) :: e
+    integer :: first
+    call check_basis(path, cs, e)
+    first = cs%model%comm%min_int(merge(e%particle, huge(1), e%code /= EMPM_OK))
+    if (first == huge(1)) then
+      e = empm_error_t()
+    else if (e%particle /= first) then
+      e = empm_error_t() ! another process holds the particle the serial run names
+    end if
+    call empm_raise_error(e, err)
+  end subroutine empm_check_basis
+
+  ! Evaluate the shape functions once (the basis storage allocated): a particle whose support
+  ! does not fit the grid is an input error, reported before any step is taken.
+  subroutine check_basis(path, cs, e)
     character(len=*), intent(in) :: path
     type(empm_case_t), intent(inout) :: cs
     type(empm_error_t), intent(inout) :: e
     integer :: ibad, info, d
     character(len=:), allocatable :: xs
-    call cs%model%finalize_setup(e)
-    if (e%code /= EMPM_OK) return
     call cs%model%shape%eval_batch(cs%model%grid, cs%model%pts, cs%model%basis, ibad, info)
     if (info /= 0) then
       xs = ''
@@ -1307,9 +1339,11 @@ contains
         end do
         xs = ' at x ='//xs//')'
       end if
+      ! Named by its id (its number in generation order, whatever process holds it).
+      if (ibad >= 1 .and. ibad <= cs%model%pts%np) ibad = cs%model%pts%id(ibad)
       call e%set(EMPM_ERR_INPUT, 'groups &grid/&particles/&shape are inconsistent: at '// &
         'particle '//str(ibad)//xs//' the '//cs%shape_name//' shape functions fail: '// &
         shape_status_text(info), file=path, particle=ibad)
     end if
-  end subroutine check_initial_basis
+  end subroutine check_basis
 end module empm_input

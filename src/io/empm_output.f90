@@ -35,7 +35,6 @@ module empm_output
     empm_errno_text, empm_write_reason, PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY
   use empm_version_info, only: empm_version
   use empm_model, only: empm_model_t
-  use empm_grid, only: empm_grid_t
   use empm_comm, only: empm_comm_t
   use empm_material, only: STATE_NAME_LEN
   use empm_history, only: empm_history_t
@@ -94,7 +93,6 @@ contains
     type(empm_error_t), intent(out), optional :: err   !! error, if present
     logical, intent(in), optional :: together          !! all processes write it (blocks)
     integer(hid_t) :: fid, g, gs, gp
-    type(empm_grid_t) :: whole
     integer :: ierr, e, k, info, n, oserr, np
     character(len=:), allocatable :: tmp, xmf, xtmp, stat
     character(len=16) :: sname
@@ -138,11 +136,10 @@ contains
     call h5_attr(fid, 'writers', merge(model%comm%nranks, 1, sf%together), ierr)
 
     call h5_group(fid, 'grid', g, ierr)
-    whole = model%grid%whole() ! a parallel process stores a window of it
-    call h5_attr(g, 'origin', whole%origin(1:whole%ndim), ierr)
-    call h5_attr(g, 'h', whole%h(1:whole%ndim), ierr)
-    call h5_attr(g, 'cells', whole%ncell(1), ierr)
-    call h5_write(g, 'cells_per_direction', whole%ncell(1:whole%ndim), ierr, sf%sh)
+    call h5_attr(g, 'origin', model%grid%origin(1:model%grid%ndim), ierr)
+    call h5_attr(g, 'h', model%grid%h(1:model%grid%ndim), ierr)
+    call h5_attr(g, 'cells', model%grid%ncell(1), ierr)
+    call h5_write(g, 'cells_per_direction', model%grid%ncell(1:model%grid%ndim), ierr, sf%sh)
     call h5_close_group(g, ierr)
 
     call h5_group(fid, 'final', g, ierr)

@@ -44,9 +44,9 @@ module empm_model
 
   !> One simulation.
   type :: empm_model_t
-    type(empm_grid_t) :: grid                           !! background grid; in a parallel run,
-                                                        !! the window of it this process
-                                                        !! stores (`grid%whole()`: all of it)
+    type(empm_grid_t) :: grid                           !! background grid; in a parallel run
+                                                        !! it stores the window of nodes this
+                                                        !! process needs ([[model_fit_window]])
     type(empm_nodes_t) :: nodes                         !! nodal fields and constraints
     type(empm_particles_t) :: pts                       !! material points
     type(empm_basis_t) :: basis                         !! shape functions at the particles
@@ -93,6 +93,7 @@ module empm_model
     procedure :: finalize_setup => model_finalize_setup
     procedure :: set_runs => model_set_runs
     procedure :: fit_window => model_fit_window
+    procedure :: share_region => model_share_region
   end type empm_model_t
 
 contains
@@ -104,9 +105,13 @@ contains
   !> the state variables. Errors (a material whose `state_names` disagree with `nstate`, a
   !> particle without a material, out of memory) go to `err` when present, which never stops
   !> the program; otherwise they are printed and the program stops.
-  subroutine model_finalize_setup(self, err)
+  subroutine model_finalize_setup(self, err, shared)
     class(empm_model_t), intent(inout) :: self          !! model
     type(empm_error_t), intent(inout), optional :: err  !! set-up error, if present
+    logical, intent(in), optional :: shared             !! the particles will be shared among
+                                                        !! processes: no basis storage yet
+                                                        !! (each process's comes with its
+                                                        !! share, [[model_set_runs]])
     type(empm_error_t) :: e
     integer :: nrun, np, nsmax, im, r, ns
     np = self%pts%np
@@ -116,7 +121,7 @@ contains
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
-    call self%set_runs(e)
+    call self%set_runs(e, basis=.not. opt_flag(shared, .false.))
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
@@ -167,15 +172,18 @@ contains
   !> The particles' basis storage and material runs (contiguous particles sharing a material:
   !> one batched update per run), for the particles the model holds now; set-up, and again
   !> when a process has taken its share of them.
-  subroutine model_set_runs(self, err)
+  subroutine model_set_runs(self, err, basis)
     class(empm_model_t), intent(inout) :: self          !! model
     type(empm_error_t), intent(inout), optional :: err  !! allocation failure, if present
+    logical, intent(in), optional :: basis              !! allocate the basis storage
+                                                        !! (default .true.)
     type(empm_error_t) :: e
     integer :: p, nrun, np, st
     character(len=256) :: msg
     np = self%pts%np
-    call self%basis%alloc(self%grid%ndim, self%shape%max_nodes(self%grid), np, &
-                          self%shape%layout(self%grid), e)
+    if (opt_flag(basis, .true.)) &
+      call self%basis%alloc(self%grid%ndim, self%shape%max_nodes(self%grid), np, &
+                            self%shape%layout(self%grid), e)
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
@@ -208,6 +216,58 @@ contains
     if (nrun > 0) self%run_last(nrun) = np
   end subroutine model_set_runs
 
+  !> Parallel runs: the nodes this process's particles reach at their current positions (the
+  !> box of their cells widened by the family's reach), agreed with the other processes
+  !> ([[empm_halo]]); when the boxes changed, the stored window of the grid is fitted to this
+  !> process's region ([[model_fit_window]]) and the exchange plan rebuilt on it. Before every
+  !> basis evaluation, and when a process has taken its share of the particles (its first
+  !> window). Collective.
+  subroutine model_share_region(model)
+    class(empm_model_t), intent(inout) :: model !! simulation state (parallel)
+    real(wp) :: xlo(3), xhi(3), v
+    integer :: lo(3), hi(3), d, p, nd, reach
+    logical :: moved
+    nd = model%grid%ndim
+    reach = model%shape%reach_cells(model%grid)
+    ! A traction acts at its face centre, up to a particle's size past the particle.
+    if (model%loads%ntraction() > 0) reach = reach + 1
+    lo = 0; hi = -1
+    if (model%pts%np > 0) then
+      xlo = 0.0_wp; xhi = 0.0_wp
+      do d = 1, nd
+        xlo(d) = huge(1.0_wp); xhi(d) = -huge(1.0_wp)
+        do p = 1, model%pts%np
+          v = model%pts%x(d, p)
+          if (v == v) then ! a NaN is left to the shape functions (min/max would trap it)
+            xlo(d) = min(xlo(d), v); xhi(d) = max(xhi(d), v)
+          end if
+        end do
+      end do
+      lo = 0; hi = 0
+      do d = 1, nd
+        ! Node c is at origin + c h: a particle in cell c reaches nodes c − reach .. c + 1 + reach.
+        ! Clamped to the grid (and past a non-finite position): a particle outside it is the
+        ! shape functions' to report, after this agreement.
+        lo(d) = floor((clamp(xlo(d), d) - model%grid%origin(d)) * model%grid%inv_h(d)) - reach
+        hi(d) = floor((clamp(xhi(d), d) - model%grid%origin(d)) * model%grid%inv_h(d)) + 1 + reach
+      end do
+    end if
+    call model%halo%update(model%comm, model%grid, lo, hi, reach)
+    if (model%halo%replan) then
+      call model%fit_window(model%halo%region(:, :, model%comm%rank + 1), moved)
+      call model%halo%plan(model%grid)
+    end if
+    model%stored_peak = max(model%stored_peak, model%grid%nnode)
+  contains
+    ! A coordinate along d within the grid box (an infinite one, or none: ±huge, too).
+    pure real(wp) function clamp(x, d)
+      real(wp), intent(in) :: x
+      integer, intent(in) :: d
+      clamp = min(max(x, model%grid%origin(d)), &
+                  model%grid%origin(d) + model%grid%ncell(d) * model%grid%h(d))
+    end function clamp
+  end subroutine model_share_region
+
   !> Parallel runs: keep the nodal storage on a window of the grid that holds `region`, the
   !> nodes this process needs (whole-grid 0-based ijk box from [[empm_halo]]; lo > hi: none),
   !> with WINDOW_SLACK nodes to spare on each side. A new window is taken when the region
@@ -222,13 +282,16 @@ contains
     type(empm_grid_t) :: new
     integer :: nd, need(3, 2), lim(3, 2), cur(3, 2)
     nd = self%grid%ndim
+    moved = .false.
+    ! Node-wise data of the shape family is indexed by the whole grid's node ids.
+    if (self%shape%node_data()) return
     need = 0; lim = 0
     if (all(region(1:nd, 1) <= region(1:nd, 2))) then
       need(1:nd, :) = region(1:nd, :)
       lim(1:nd, 1) = max(region(1:nd, 1) - 2 * WINDOW_SLACK, 0)
-      lim(1:nd, 2) = min(region(1:nd, 2) + 2 * WINDOW_SLACK, self%grid%gnn(1:nd) - 1)
+      lim(1:nd, 2) = min(region(1:nd, 2) + 2 * WINDOW_SLACK, self%grid%nn(1:nd) - 1)
     end if
-    cur(:, 1) = self%grid%off; cur(:, 2) = self%grid%off + self%grid%nn - 1
+    cur(:, 1) = self%grid%off; cur(:, 2) = self%grid%off + self%grid%ln - 1
     moved = .not. all(cur(1:nd, 1) <= need(1:nd, 1) .and. cur(1:nd, 2) >= need(1:nd, 2) .and. &
                       cur(1:nd, 1) >= lim(1:nd, 1) .and. cur(1:nd, 2) <= lim(1:nd, 2))
     if (.not. moved) return
@@ -240,8 +303,15 @@ contains
     call self%nodes%window(self%grid, new)
     self%grid = new
     self%windows = self%windows + 1
-    self%stored_peak = max(self%stored_peak, new%nnode)
   end subroutine model_fit_window
+
+  ! An optional flag's value, `default` when it is absent.
+  pure logical function opt_flag(flag, default)
+    logical, intent(in), optional :: flag
+    logical, intent(in) :: default
+    opt_flag = default
+    if (present(flag)) opt_flag = flag
+  end function opt_flag
 
   !> A material's state variables must have as many names as `nstate`, each made of letters,
   !> digits and '_' (they name HDF5 datasets and XDMF attributes), without repeats.

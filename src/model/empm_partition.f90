@@ -6,7 +6,6 @@ module empm_partition
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, empm_raise_error
   use empm_model, only: empm_model_t
-  use empm_grid, only: empm_grid_t
   use empm_history, only: empm_history_t, empm_snapshot_t
   use empm_decomp, only: empm_rcb, empm_cell_of, empm_box_owner
   implicit none
@@ -59,6 +58,8 @@ contains
     model%nodes%mass_tol = mass_tol
     call keep_boxes(model, lo, hi)
     model%boxes0 = model%boxes
+    ! The first window of the grid (the whole grid's nodal storage is given back).
+    call model%share_region()
   end subroutine empm_partition_particles
 
   ! The particles this process holds in each cell (direction 1 fastest), and the cells per
@@ -67,15 +68,13 @@ contains
     type(empm_model_t), intent(in) :: model
     integer, intent(out) :: nc(3)
     integer, allocatable, intent(out) :: counts(:)
-    type(empm_grid_t) :: whole
     integer :: p, ijk(3), c
-    whole = model%grid%whole() ! a parallel process stores a window of it
     nc = 1
-    nc(1:whole%ndim) = whole%ncell(1:whole%ndim)
+    nc(1:model%grid%ndim) = model%grid%ncell(1:model%grid%ndim)
     allocate(counts(product(nc)))
     counts = 0
     do p = 1, model%pts%np
-      ijk = empm_cell_of(whole, model%pts%x(:, p))
+      ijk = empm_cell_of(model%grid, model%pts%x(:, p))
       c = ijk(1) + nc(1) * ((ijk(2) - 1) + nc(2) * (ijk(3) - 1))
       counts(c) = counts(c) + 1
     end do
@@ -86,11 +85,9 @@ contains
     type(empm_model_t), intent(in) :: model
     integer, intent(in) :: lo(:,:), hi(:,:)
     integer :: dest(model%pts%np)
-    type(empm_grid_t) :: whole
     integer :: p
-    whole = model%grid%whole()
     do p = 1, model%pts%np
-      dest(p) = empm_box_owner(lo, hi, empm_cell_of(whole, model%pts%x(:, p))) - 1
+      dest(p) = empm_box_owner(lo, hi, empm_cell_of(model%grid, model%pts%x(:, p))) - 1
     end do
   end function owners
 

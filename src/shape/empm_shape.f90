@@ -78,6 +78,7 @@ module empm_shape
     procedure :: configure => shape_configure
     procedure :: padding_cells => shape_padding_cells
     procedure :: reach_cells => shape_reach_cells
+    procedure :: node_data => shape_node_data
   end type empm_shape_t
 
   abstract interface
@@ -171,6 +172,15 @@ contains
     associate (unused_ => grid); end associate
     n = self%padding_cells()
   end function shape_reach_cells
+
+  !> Whether the family holds data per grid node, indexed by node id (LME's node-wise γ): a
+  !> parallel process then stores the whole grid, not a window of it (docs/parallel.md). The
+  !> default: none.
+  pure logical function shape_node_data(self)
+    class(empm_shape_t), intent(in) :: self !! shape family
+    associate (unused_ => self); end associate
+    shape_node_data = .false.
+  end function shape_node_data
 
   !> Basis layout the family fills fastest on `grid`; the default is BASIS_LISTS, the only
   !> layout every family fills. A family overriding it must fill that layout in `eval_batch`.

@@ -118,7 +118,7 @@ contains
     if (q4 .or. (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4)) then
       ! 2D: one bilinear kernel call per chunk of particles.
       if (q4) then
-        basis%stride = grid%nn(1); basis%inv_h = grid%inv_h(1:2)
+        basis%stride = grid%ln(1); basis%inv_h = grid%inv_h(1:2)
       end if
       nc = empm_chunks(pts%np)
       ibad = huge(1)
@@ -217,7 +217,7 @@ contains
     integer, intent(out) :: ibad             !! first particle outside the grid, huge(1) if none
     real(wp) :: t(2, 1)
     integer :: p, id(1), n1, b
-    n1 = grid%nn(1)
+    n1 = grid%ln(1)
     ibad = huge(1)
     do p = p0, p1
       ! Located as for the compact layout (one particle: x(1, p) starts its coordinate pair).
@@ -249,12 +249,12 @@ contains
     real(wp), intent(inout) :: t(2, *)       !! local coordinates
     integer, intent(out) :: ibad             !! first particle outside the grid, huge(1) if none
     real(wp) :: o1, o2, e1, e2, h1, h2, s1, s2
-    integer :: p, i0, j0, n1, c1, c2
+    integer :: p, i0, j0, n1, c1, c2, id0
     o1 = grid%origin(1); o2 = grid%origin(2)
     e1 = grid%origin(1) + grid%ncell(1) * grid%h(1)
     e2 = grid%origin(2) + grid%ncell(2) * grid%h(2)
     h1 = grid%inv_h(1); h2 = grid%inv_h(2)
-    n1 = grid%nn(1); c1 = grid%ncell(1) - 1; c2 = grid%ncell(2) - 1
+    n1 = grid%ln(1); id0 = grid%id0; c1 = grid%ncell(1) - 1; c2 = grid%ncell(2) - 1
     ibad = huge(1)
     do p = p0, p1
       if (.not. (x(1, p) >= o1 .and. x(1, p) <= e1 .and. x(2, p) >= o2 .and. &
@@ -268,7 +268,7 @@ contains
       s2 = (x(2, p) - o2) * h2
       i0 = min(int(s1), c1)
       j0 = min(int(s2), c2)
-      cell(p) = 1 + i0 + n1 * j0
+      cell(p) = id0 + i0 + n1 * j0
       t(1, p) = min(s1 - i0, 1.0_wp)
       t(2, p) = min(s2 - j0, 1.0_wp)
     end do
@@ -317,13 +317,13 @@ contains
         info = SHAPE_SUPPORT_CLIPPED; return
       end if
     end do
-    n1 = grid%nn(1); n12 = grid%nn(1) * grid%nn(2)
+    n1 = grid%ln(1); n12 = grid%ln(1) * grid%ln(2)
     a = 0
     do k3 = 1, m(3)
       do k2 = 1, m(2)
         w23 = w(k2, 2) * w(k3, 3)
         ! grid%node_id of (base(1), base(2) + k2 − 1, base(3) + k3 − 1), the row's first node
-        row = 1 + base(1) + n1 * (base(2) + k2 - 1) + n12 * (base(3) + k3 - 1)
+        row = grid%id0 + base(1) + n1 * (base(2) + k2 - 1) + n12 * (base(3) + k3 - 1)
         do k1 = 1, m(1)
           a = a + 1
           node(a) = row + k1 - 1
@@ -364,12 +364,12 @@ contains
       basis%nn(p) = 0
       info = SHAPE_TOO_MANY_NODES; return
     end if
-    n1 = grid%nn(1); n12 = grid%nn(1) * grid%nn(2)
+    n1 = grid%ln(1); n12 = grid%ln(1) * grid%ln(2)
     a = 0
     if (grid%ndim == 2) then
       ! w(k3, 3) = 1: w23 = w(k2, 2) and w13 = w(k1, 1) exactly.
       do k2 = 1, m(2)
-        row = 1 + base(1) + n1 * (base(2) + k2 - 1)
+        row = grid%id0 + base(1) + n1 * (base(2) + k2 - 1)
         do k1 = 1, m(1)
           a = a + 1
           basis%node(a, p) = row + k1 - 1
@@ -382,7 +382,7 @@ contains
       do k3 = 1, m(3)
         do k2 = 1, m(2)
           w23 = w(k2, 2) * w(k3, 3)
-          row = 1 + base(1) + n1 * (base(2) + k2 - 1) + n12 * (base(3) + k3 - 1)
+          row = grid%id0 + base(1) + n1 * (base(2) + k2 - 1) + n12 * (base(3) + k3 - 1)
           do k1 = 1, m(1)
             a = a + 1
             basis%node(a, p) = row + k1 - 1

@@ -155,6 +155,7 @@ module empm_shape_lme
     procedure :: set_gamma_box => lme_set_gamma_box
     procedure :: support_radius => lme_radius
     procedure :: reach_cells => lme_reach_cells
+    procedure :: node_data => lme_node_data
   end type empm_shape_lme_t
 
   interface
@@ -202,6 +203,11 @@ module empm_shape_lme
       class(empm_shape_lme_t), intent(in) :: self !! shape family
       character(len=:), allocatable :: s          !! identifier
     end function lme_name
+
+    !> Whether γ is set per node (`set_gamma_nodes`, `set_gamma_box`): indexed by node id.
+    module pure logical function lme_node_data(self)
+      class(empm_shape_lme_t), intent(in) :: self !! shape family
+    end function lme_node_data
 
     !> Cells beyond a particle's own that its support reaches: ⌈R_max/h⌉ with the remedy's
     !> enlargement (0 for invalid parameters).

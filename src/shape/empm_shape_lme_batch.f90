@@ -177,7 +177,7 @@ contains
       xlo1 = huge(1.0_wp); xhi1 = -huge(1.0_wp); xlo2 = huge(1.0_wp); xhi2 = -huge(1.0_wp)
       do j = lo2, hi2
         xi2 = (x(2) - (grid%origin(2) + j * grid%h(2))) / h
-        id0 = 1 + grid%nn(1) * j
+        id0 = grid%id0 + grid%ln(1) * j
         do i = lo1, hi1
           xi1 = (x(1) - (grid%origin(1) + i * grid%h(1))) / h
           q = gamma * (xi1**2 + xi2**2)

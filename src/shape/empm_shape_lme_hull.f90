@@ -69,7 +69,7 @@ contains
       do j = lo(2), hi(2)
         do i = lo(1), hi(1)
           ijk = [i, j, k]
-          if (grid%node_id(ijk) /= 0) cycle
+          if (all(ijk >= 0 .and. ijk < grid%nn)) cycle ! a node of the grid
           dist2 = 0.0_wp
           do d = 1, grid%ndim
             dist2 = dist2 + (x(d) - (grid%origin(d) + ijk(d) * grid%h(d)))**2

@@ -78,7 +78,7 @@ contains
       if (nd >= 3) xi(3) = (x(3) - (grid%origin(3) + k * grid%h(3))) / hs
       do j = lo(2), hi(2)
         if (nd >= 2) xi(2) = (x(2) - (grid%origin(2) + j * grid%h(2))) / hs
-        id0 = 1 + grid%nn(1) * (j + grid%nn(2) * k)
+        id0 = grid%id0 + grid%ln(1) * (j + grid%ln(2) * k)
         do i = lo(1), hi(1)
           id = id0 + i
           xi(1) = (x(1) - (grid%origin(1) + i * grid%h(1))) / hs

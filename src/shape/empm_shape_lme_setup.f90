@@ -109,6 +109,10 @@ contains
     s = trim(adjustl(buf))
   end procedure lme_format_gamma
 
+  module procedure lme_node_data
+    lme_node_data = allocated(self%gamma_node)
+  end procedure lme_node_data
+
   module procedure lme_reach_cells
     real(wp) :: rr
     n = 0

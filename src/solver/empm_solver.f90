@@ -8,7 +8,6 @@ module empm_solver
                         EMPM_ERR_RUNTIME, EMPM_ERR_USAGE, EMPM_ERR_INTERRUPTED
   use empm_strings, only: str, join
   use empm_partition, only: empm_rebalance, empm_share_traction_state
-  use empm_grid, only: empm_grid_t
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK, STEP_SHAPE_FAILED
   use empm_loads, only: RAMP_NONE
   use empm_integrator, only: empm_integrator_t
@@ -542,7 +541,6 @@ contains
 
     ! The statistics of the run so far (the model holds the last good state).
     subroutine finish_stats()
-      type(empm_grid_t) :: whole
       call system_clock(clock)
       st%wall = real(clock - clock0, wp) / real(rate, wp)
       if (st%steps == 0) st%dt_min = 0.0_wp
@@ -551,8 +549,7 @@ contains
       call empm_energies(model, psi, ekin, estr, egrav)
       st%energy_final = ekin + estr + egrav
       st%halo_bytes = model%comm%max_real(real(model%halo%sent - sent0, wp) / max(st%steps, 1))
-      whole = model%grid%whole()
-      st%grid_nodes = whole%nnode
+      st%grid_nodes = product(model%grid%nn)
       st%stored_nodes = nint(model%comm%max_real(real(model%stored_peak, wp)))
       st%windows = model%comm%sum_int(model%windows)
       if (present(stats)) stats = st
@@ -722,9 +719,8 @@ contains
       end do
     end associate
     do k = 1, nd
-      ! The whole grid's box (a parallel process stores a window of it).
-      upper = model%grid%gorigin(k) + (model%grid%gnn(k) - 1) * model%grid%h(k)
-      if (np > 0 .and. .not. (lo(k) >= model%grid%gorigin(k) .and. hi(k) <= upper)) return
+      upper = model%grid%origin(k) + model%grid%ncell(k) * model%grid%h(k)
+      if (np > 0 .and. .not. (lo(k) >= model%grid%origin(k) .and. hi(k) <= upper)) return
     end do
     do I = 1, model%nodes%nplane
       k = abs(model%nodes%plane_side(I))
@@ -844,10 +840,10 @@ contains
     type(empm_model_t), intent(in) :: model !! simulation state
     integer, intent(out), optional :: where !! id of the particle it names; huge(1) for a node
                                             !! or no problem
-    integer, intent(out), optional :: node  !! the node it names; huge(1) for a particle or
-                                            !! no problem
+    integer, intent(out), optional :: node  !! the node it names (the whole grid's number);
+                                            !! huge(1) for a particle or no problem
     character(len=:), allocatable :: msg    !! '' or the first problem found
-    integer :: p, I
+    integer :: p, I, G, ijk(3)
     msg = ''
     if (present(where)) where = huge(1)
     if (present(node)) node = huge(1)
@@ -898,13 +894,16 @@ contains
     do I = 1, model%nodes%nnode
       ! A parallel run's nodes are complete only where this process's particles reach.
       if (.not. model%halo%in_core(model%grid, I)) cycle
+      ! Named by the whole grid's number (a parallel process stores a window of the grid).
+      ijk = model%grid%node_ijk(I)
+      G = 1 + ijk(1) + model%grid%nn(1) * (ijk(2) + model%grid%nn(2) * ijk(3))
       if (.not. all(ieee_is_finite(model%nodes%vel(:, I)))) then
-        msg = 'step '//str(model%step)//': non-finite nodal velocity at node '//str(I)
+        msg = 'step '//str(model%step)//': non-finite nodal velocity at node '//str(G)
       else if (.not. all(ieee_is_finite(model%nodes%acc(:, I)))) then
-        msg = 'step '//str(model%step)//': non-finite nodal acceleration at node '//str(I)
+        msg = 'step '//str(model%step)//': non-finite nodal acceleration at node '//str(G)
       end if
       if (len(msg) > 0) then
-        if (present(node)) node = I
+        if (present(node)) node = G
         return
       end if
     end do

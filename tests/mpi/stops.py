@@ -4,7 +4,10 @@
    process with exit status 3 and one message, naming the particle as the serial run does, and
    the results written (marked incomplete) equal the serial run's last good state;
 2. a stress update that fails on one process (a particle inverted) does the same;
-3. a case file error is reported once, with exit status 2 on every process;
+3. a case file error is reported once, with exit status 2 on every process; so is a particle
+   whose support does not fit the grid, found by the process holding it once the particles
+   are shared (several processes hold such particles; the serial run's, the smallest id, is
+   named);
 4. case 1 with a surface traction and checkpoints (its loaded particles shared out, the
    checkpoints gathered) stops the same way, with the serial run's message and last good state;
 5. a file the case needs that is missing on one process only (its own working folder, with
@@ -57,6 +60,27 @@ INVERT = LEAVE.replace("E = 1.0e4", "E = 1.0") \
 """)
 
 BAD = LEAVE.replace("cfl = 0.5", "cfl = -0.5")
+# Quadratic B-splines without padding: the particles next to the right face (and those of a
+# second body there, later ids) need nodes beyond the grid.
+UNFIT = """&grid
+  ndim = 2, h = 0.1, cells = 40, 10
+/
+&material
+  name = 'm', model = 'linear_elastic', E = 1.0e6, nu = 0.3, density = 2000.0
+/
+&particles
+  material = 'm', lo = 0.3, 0.3, hi = 4.0, 0.5
+/
+&particles
+  material = 'm', lo = 3.0, 0.5, hi = 4.0, 1.0
+/
+&shape
+  family = 'bspline2'
+/
+&integrator
+  scheme = 'musl', t_end = 0.01
+/
+"""
 # Checkpoints of a case with surface tractions (their per-particle state is not gathered yet).
 CKPT = LEAVE.replace("snapshot_times = 0.05", "snapshot_times = 0.05, checkpoint_every = 10") \
     .replace("material = 'm', geometry = 'box', lo = 0.2, 0.2, hi = 0.8, 0.8, ppc = 2",
@@ -89,7 +113,7 @@ def main():
     mpi = [mpirun, "--oversubscribe"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
     fails = []
     for name, text, status in [("leave", LEAVE, 3), ("invert", INVERT, 3), ("bad", BAD, 2),
-                               ("ckpt", CKPT, 3)]:
+                               ("unfit", UNFIT, 2), ("ckpt", CKPT, 3)]:
         nml = work / f"{name}.nml"
         nml.write_text(text)
         rc, slog = run([empm, "run", str(nml), "-o", f"{name}_s.h5"], work)
