@@ -135,8 +135,14 @@ contains
       return
     end if
     ! A case read to be shared among processes gets its nodal fields with its first window
-    ! of the grid; one that was not shared gets them here, on the grid it stores.
+    ! of the grid, and its basis with its share; one that was not shared gets them here.
     if (size(model%nodes%mass) /= model%nodes%nnode) call model%nodes%window(model%grid, model%grid)
+    if (.not. allocated(model%basis%nn) .and. .not. allocated(model%basis%cell)) then
+      call model%set_runs(err)
+      if (present(err)) then
+        if (err%code /= 0) return
+      end if
+    end if
     if (allocated(self%bwork)) deallocate(self%bwork)
     allocate(self%bwork(model%grid%ndim, model%pts%np), stat=stat, errmsg=msg)
     if (stat /= 0) then

@@ -197,6 +197,17 @@ contains
     else if (present(auto_threads)) then
       if (auto_threads) call choose_threads()
     end if
+    if (shared) then
+      ! Each process takes its share of the particles, its window of the grid, and checks its
+      ! share's shape functions: the set-up a serial run finishes in empm_read_case, before
+      ! the output is claimed (an unfit case is the same input error, exit 2).
+      call empm_partition_particles(cs%model, e)
+      if (e%code == EMPM_OK) call empm_check_basis(path, cs, e)
+      call empm_agree_error(cs%model%comm, e)
+      if (e%code /= EMPM_OK) then
+        call empm_raise_error(e, err); return
+      end if
+    end if
     ! The root claims the output for all (one file, one lock); its verdict is everyone's.
     if (cs%model%comm%is_root()) call empm_output_claim(cs%output_file, e)
     call empm_agree_error(cs%model%comm, e)
@@ -227,11 +238,7 @@ contains
         write(error_unit, '(a)') 'empm: note: '//warning
     end if
     if (cs%model%comm%parallel()) then
-      call empm_partition_particles(cs%model, e, hist)
-      if (e%code == EMPM_OK .and. shared) then
-        call empm_check_basis(path, cs, e)
-        call empm_agree_error(cs%model%comm, e)
-      end if
+      if (.not. shared) call empm_partition_particles(cs%model, e, hist)
       if (e%code /= EMPM_OK) then
         call release(); call empm_raise_error(e, err); return
       end if

@@ -261,8 +261,9 @@ contains
                                                               !! processes: the nodal fields
                                                               !! wait for each one's window of
                                                               !! the grid, the basis and its
-                                                              !! check ([[empm_check_basis]])
-                                                              !! for each one's share
+                                                              !! check for each one's share:
+                                                              !! call empm_partition_particles,
+                                                              !! then [[empm_check_basis]]
                                                               !! (docs/parallel.md)
     type(empm_overrides_t) :: ov
     type(empm_registry_t) :: reg

@@ -30,7 +30,12 @@ contains
     integer :: lo(3, model%comm%nranks), hi(3, model%comm%nranks), nc(3)
     integer :: p, n
     real(wp) :: mass_tol
-    if (.not. model%comm%parallel()) return
+    if (.not. model%comm%parallel()) then
+      ! One process keeps every particle; a case read to be shared gets its basis here.
+      if (.not. allocated(model%basis%nn) .and. .not. allocated(model%basis%cell)) &
+        call model%set_runs(err)
+      return
+    end if
     ! Every process holds every particle here: its own counts are the whole run's.
     call cell_counts(model, nc, counts)
     call empm_rcb(model%grid%ndim, nc(1:model%grid%ndim), counts, model%comm%nranks, lo, hi)
