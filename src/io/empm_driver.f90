@@ -171,9 +171,10 @@ contains
     ! Shared among processes, the case waits for each one's share of the particles to store
     ! its window of the grid and its basis (a restart replaces the particles: it is set up
     ! whole, as before).
+    resumed = .false.
+    if (present(restart)) resumed = len_trim(restart) > 0
     shared = .false.
-    if (present(comm) .and. present(restart)) shared = comm%parallel() .and. len_trim(restart) == 0
-    if (present(comm) .and. .not. present(restart)) shared = comm%parallel()
+    if (present(comm)) shared = comm%parallel() .and. .not. resumed
     call empm_read_case(path, cs, e, extra_groups=extra_groups, shared=shared)
     ! Each process reads the case: one that cannot (a file missing on its machine) must not
     ! leave the others waiting. All take the error of the first process that has one.
@@ -186,8 +187,6 @@ contains
     end if
     if (present(progress)) cs%run%progress = progress
     if (present(comm)) cs%model%comm = comm
-    resumed = .false.
-    if (present(restart)) resumed = len_trim(restart) > 0
     if (cs%model%comm%parallel()) then
       ! One thread per process unless OMP_NUM_THREADS or --threads say otherwise: the
       ! processes already share the cores.
