@@ -6,12 +6,14 @@
 !> and costs nothing. No global state: whoever makes the value owns it (docs/parallel.md).
 module empm_comm
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t, EMPM_OK
 #ifdef EMPM_USE_MPI
   use mpi_f08, only: MPI_Comm, MPI_COMM_WORLD, MPI_COMM_NULL, MPI_Init, MPI_Initialized, &
     MPI_Finalize, MPI_Finalized, MPI_Comm_rank, MPI_Comm_size, MPI_Comm_dup, MPI_Comm_free, &
     MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_SUM, &
     MPI_Op, MPI_MAX, MPI_MIN, MPI_LOR, MPI_Bcast, MPI_Alltoall, MPI_Alltoallv, MPI_CHARACTER, &
-    MPI_Gather, MPI_Gatherv, MPI_Barrier, MPI_Allgather, MPI_Request, MPI_Isend, MPI_Irecv, &
+    MPI_Gather, MPI_Gatherv, MPI_Barrier, MPI_Allgather, MPI_Allgatherv, MPI_Request, &
+    MPI_Isend, MPI_Irecv, &
     MPI_Waitall, MPI_STATUSES_IGNORE, MPI_Abort, operator(/=)
 #endif
   implicit none
@@ -44,11 +46,13 @@ module empm_comm
     procedure :: min_real => comm_min_real
     procedure :: sum_int => comm_sum_int
     procedure :: sum_counts => comm_sum_counts
+    procedure :: max_reals => comm_max_reals
     procedure :: max_int => comm_max_int
     procedure :: min_int => comm_min_int
     procedure :: bcast_ints => comm_bcast_ints
     procedure :: any_true => comm_any_true
     procedure :: bcast_text => comm_bcast_text
+    procedure :: agree => comm_agree
     procedure :: gather_rows => comm_gather_rows
     procedure :: exchange_rows => comm_exchange_rows
     procedure :: allgather_ints => comm_allgather_ints
@@ -206,6 +210,16 @@ contains
 #endif
   end subroutine comm_sum_counts
 
+  !> a ← the largest value over the processes, entry by entry (every process gets it).
+  subroutine comm_max_reals(self, a)
+    class(empm_comm_t), intent(in) :: self      !! communicator
+    real(wp), intent(inout), contiguous :: a(:) !! values, maximised in place
+    if (self%nranks <= 1 .or. size(a) == 0) return
+#ifdef EMPM_USE_MPI
+    call MPI_Allreduce(MPI_IN_PLACE, a, size(a), MPI_DOUBLE_PRECISION, MPI_MAX, self%handle)
+#endif
+  end subroutine comm_max_reals
+
   !> Σ over the processes of x.
   function comm_sum_real(self, x) result(s)
     class(empm_comm_t), intent(in) :: self !! communicator
@@ -335,17 +349,41 @@ contains
 #endif
   end subroutine comm_bcast_text
 
+  !> Every process takes the error of the first process that has one (or none): so that all
+  !> stop together, where one alone (a file missing on its machine) would leave the others
+  !> waiting in the next collective. Collective.
+  subroutine comm_agree(self, e)
+    class(empm_comm_t), intent(in) :: self     !! communicator
+    type(empm_error_t), intent(inout) :: e     !! this process's outcome in, the first one out
+    integer :: first, v(1)
+    character(len=:), allocatable :: text
+    if (self%nranks <= 1) return
+    first = self%min_int(merge(self%rank, self%nranks, e%code /= EMPM_OK))
+    if (first == self%nranks) return
+    v(1) = e%code
+    call self%bcast_ints(v, first)
+    text = ''
+    if (self%rank == first) text = e%message
+    call self%bcast_text(text, first)
+    if (self%rank /= first) then
+      e%code = v(1); e%message = text
+    end if
+  end subroutine comm_agree
+
   !> The root gets every process's rows, process by process: rows(:, 1:n) here, all(:, :) on
-  !> the root (allocated there with the total count of columns; elsewhere size 0).
-  subroutine comm_gather_rows(self, rows, n, all)
+  !> the root (allocated there with the total count of columns; elsewhere size 0). With
+  !> `to_all`, every process gets them (for short lists: a surface's particles, not a body's).
+  subroutine comm_gather_rows(self, rows, n, all, to_all)
     class(empm_comm_t), intent(in) :: self                  !! communicator
     real(wp), intent(in), contiguous :: rows(:,:)           !! this process's rows (m, >= n)
     integer, intent(in) :: n                                !! its number of columns
     real(wp), allocatable, intent(out) :: all(:,:)          !! the root's (m, Σ n)
+    logical, intent(in), optional :: to_all                 !! every process gets all(:, :)
     integer :: m
 #ifdef EMPM_USE_MPI
     integer, allocatable :: counts(:), displs(:)
     integer :: k
+    logical :: everyone
 #endif
     m = size(rows, 1)
     if (self%nranks <= 1) then
@@ -354,9 +392,15 @@ contains
       return
     end if
 #ifdef EMPM_USE_MPI
+    everyone = .false.
+    if (present(to_all)) everyone = to_all
     allocate(counts(self%nranks), displs(self%nranks))
-    call MPI_Gather(m * n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, 0, self%handle)
-    if (self%rank == 0) then
+    if (everyone) then
+      call MPI_Allgather(m * n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, self%handle)
+    else
+      call MPI_Gather(m * n, 1, MPI_INTEGER, counts, 1, MPI_INTEGER, 0, self%handle)
+    end if
+    if (self%rank == 0 .or. everyone) then
       displs(1) = 0
       do k = 2, self%nranks
         displs(k) = displs(k - 1) + counts(k - 1)
@@ -365,8 +409,13 @@ contains
     else
       allocate(all(m, 0))
     end if
-    call MPI_Gatherv(rows, m * n, MPI_DOUBLE_PRECISION, all, counts, displs, &
-                     MPI_DOUBLE_PRECISION, 0, self%handle)
+    if (everyone) then
+      call MPI_Allgatherv(rows, m * n, MPI_DOUBLE_PRECISION, all, counts, displs, &
+                          MPI_DOUBLE_PRECISION, self%handle)
+    else
+      call MPI_Gatherv(rows, m * n, MPI_DOUBLE_PRECISION, all, counts, displs, &
+                       MPI_DOUBLE_PRECISION, 0, self%handle)
+    end if
 #endif
   end subroutine comm_gather_rows
 
@@ -381,6 +430,7 @@ contains
     real(wp), allocatable :: sorted(:,:)
     integer, allocatable :: scount(:), sdisp(:), rcount(:), rdisp(:), next(:)
     integer :: m, k, q
+    logical :: grouped
     m = size(rows, 1)
     if (self%nranks <= 1) then
       allocate(got(m, n))
@@ -397,14 +447,23 @@ contains
     do q = 2, self%nranks
       sdisp(q) = sdisp(q - 1) + scount(q - 1)
     end do
-    ! Rows grouped by destination, each group in this process's order.
-    allocate(sorted(m, n))
-    next = sdisp
-    do k = 1, n
-      q = dest(k) + 1
-      next(q) = next(q) + 1
-      sorted(:, next(q)) = rows(:, k)
+    ! Rows grouped by destination, each group in this process's order: a copy, unless they
+    ! come so already (particles in id order sent to the owners of blocks of ids).
+    grouped = .true.
+    do k = 2, n
+      if (dest(k) < dest(k - 1)) then
+        grouped = .false.; exit
+      end if
     end do
+    if (.not. grouped) then
+      allocate(sorted(m, n))
+      next = sdisp
+      do k = 1, n
+        q = dest(k) + 1
+        next(q) = next(q) + 1
+        sorted(:, next(q)) = rows(:, k)
+      end do
+    end if
     rcount = scount
 #ifdef EMPM_USE_MPI
     call MPI_Alltoall(scount, 1, MPI_INTEGER, rcount, 1, MPI_INTEGER, self%handle)
@@ -415,8 +474,13 @@ contains
     end do
     allocate(got(m, sum(rcount)))
 #ifdef EMPM_USE_MPI
-    call MPI_Alltoallv(sorted, m * scount, m * sdisp, MPI_DOUBLE_PRECISION, got, m * rcount, &
-                       m * rdisp, MPI_DOUBLE_PRECISION, self%handle)
+    if (grouped) then
+      call MPI_Alltoallv(rows, m * scount, m * sdisp, MPI_DOUBLE_PRECISION, got, m * rcount, &
+                         m * rdisp, MPI_DOUBLE_PRECISION, self%handle)
+    else
+      call MPI_Alltoallv(sorted, m * scount, m * sdisp, MPI_DOUBLE_PRECISION, got, &
+                         m * rcount, m * rdisp, MPI_DOUBLE_PRECISION, self%handle)
+    end if
 #endif
   end subroutine comm_exchange_rows
 

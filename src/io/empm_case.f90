@@ -5,6 +5,7 @@ module empm_case
   use empm_model, only: empm_model_t
   use empm_integrator, only: empm_integrator_t
   use empm_solver, only: empm_run_config_t
+  use empm_particle_gen, only: empm_deal_t
   implicit none
   private
   public :: empm_case_t, empm_overrides_t
@@ -34,6 +35,10 @@ module empm_case
     integer, allocatable :: probe_particle(:)        !! particle followed by each probe
     character(len=:), allocatable :: shape_name      !! shape family identifier
     character(len=:), allocatable :: scheme_name     !! integrator identifier
+    !> The particles generated, and this process's share of them when the case is read to be
+    !> shared by place among processes (each stores its share only: body_first..body_last
+    !> below are then its own particles of each body).
+    type(empm_deal_t) :: deal
     ! Bodies (&particles groups, in order): their particles are body_first..body_last.
     character(len=64), allocatable :: body_name(:)   !! body labels ('' when unnamed)
     integer, allocatable :: body_first(:)            !! first particle of each body

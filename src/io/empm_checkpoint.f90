@@ -25,6 +25,7 @@ module empm_checkpoint
   use empm_model, only: empm_model_t
   use empm_history, only: empm_history_t
   use empm_solver, only: empm_solver_state_t
+  use empm_particle_gen, only: empm_deal_t
   use empm_output, only: empm_shared_file_t
   implicit none
   private
@@ -216,7 +217,7 @@ contains
   !> not an empm checkpoint, or was written by another version of empm, for another case file
   !> (`case_text` differs) or for another particle set. `warning` is '' or a note (another
   !> number of threads: the run continues, but not bitwise).
-  subroutine empm_checkpoint_read(path, model, hist, state, case_text, warning, err)
+  subroutine empm_checkpoint_read(path, model, hist, state, case_text, warning, err, dealt)
     character(len=*), intent(in) :: path               !! checkpoint file
     type(empm_model_t), intent(inout) :: model         !! model to restore into
     type(empm_history_t), intent(inout) :: hist        !! histories to restore into
@@ -224,7 +225,12 @@ contains
     character(len=*), intent(in) :: case_text          !! full text of this run's case file
     character(len=:), allocatable, intent(out) :: warning !! '' or a note for the user
     type(empm_error_t), intent(out) :: err             !! error, if any
+    type(empm_deal_t), intent(in), optional :: dealt   !! the case's particles dealt out among
+                                                       !! processes: each reads its share (its
+                                                       !! ids, of particles and snapshots)
     integer(hid_t) :: fid, g, gs, gk
+    integer :: cols(2), ntotal
+    logical :: share
     character(len=:), allocatable :: s
     real(wp), allocatable :: r1(:), r2(:,:)
     real(wp) :: sc(7), cnt(5)
@@ -267,15 +273,23 @@ contains
     if (ierr /= 0) then
       call refuse('its attributes particles, ndim, nstate, threads are incomplete'); return
     end if
-    if (np /= model%pts%np .or. nd /= model%grid%ndim .or. ns /= model%pts%nstate) then
+    ! Dealt out, this process reads the columns of its ids: rank + 1, rank + 1 + P, ...
+    share = .false.; ntotal = model%pts%np; cols = [0, 1]
+    if (present(dealt)) then
+      share = dealt%every > 1
+      if (share) then
+        ntotal = dealt%n; cols = [dealt%rank, dealt%every]
+      end if
+    end if
+    if (np /= ntotal .or. nd /= model%grid%ndim .or. ns /= model%pts%nstate) then
       call refuse('it holds '//str(np)//' particles in '//str(nd)//'D with '//str(ns)// &
-        ' state variables, the case '//str(model%pts%np)//' in '//str(model%grid%ndim)// &
+        ' state variables, the case '//str(ntotal)//' in '//str(model%grid%ndim)// &
         'D with '//str(model%pts%nstate)); return
     end if
     if (threads /= empm_max_threads()) warning = 'the checkpoint was written with '// &
       str(threads)//' threads, this run uses '//str(empm_max_threads())//': it continues, '// &
       'but not bitwise as the uninterrupted run (the sums over particles follow the threads)'
-    n = np
+    n = model%pts%np
 
     ! Everything below exists in a file written by empm_checkpoint_write of this version.
     call open_group(fid, 'model', g)
@@ -285,29 +299,32 @@ contains
 
     call open_group(fid, 'particles', g)
     associate (p => model%pts)
-      call h5_read(g, 'x', p%x(:, 1:n), ierr); call h5_read(g, 'x0', p%x0(:, 1:n), ierr)
-      call h5_read(g, 'v', p%v(:, 1:n), ierr); call h5_read(g, 'a', p%a(:, 1:n), ierr)
-      call h5_read(g, 'dx', p%dx(:, 1:n), ierr)
-      call h5_read(g, 'm', p%m(1:n), ierr); call h5_read(g, 'vol', p%vol(1:n), ierr)
-      call h5_read(g, 'vol0', p%vol0(1:n), ierr); call h5_read(g, 'rho', p%rho(1:n), ierr)
-      call h5_read(g, 'stress', p%stress(:, 1:n), ierr)
-      call h5_read(g, 'strain', p%strain(:, 1:n), ierr)
-      allocate(r2(9, n)); call h5_read(g, 'F', r2, ierr)
+      call h5_read(g, 'x', p%x(:, 1:n), ierr, cols)
+      call h5_read(g, 'x0', p%x0(:, 1:n), ierr, cols)
+      call h5_read(g, 'v', p%v(:, 1:n), ierr, cols)
+      call h5_read(g, 'a', p%a(:, 1:n), ierr, cols)
+      call h5_read(g, 'dx', p%dx(:, 1:n), ierr, cols)
+      call h5_read(g, 'm', p%m(1:n), ierr, cols); call h5_read(g, 'vol', p%vol(1:n), ierr, cols)
+      call h5_read(g, 'vol0', p%vol0(1:n), ierr, cols)
+      call h5_read(g, 'rho', p%rho(1:n), ierr, cols)
+      call h5_read(g, 'stress', p%stress(:, 1:n), ierr, cols)
+      call h5_read(g, 'strain', p%strain(:, 1:n), ierr, cols)
+      allocate(r2(9, n)); call h5_read(g, 'F', r2, ierr, cols)
       p%F(:, :, 1:n) = reshape(r2, [3, 3, n]); deallocate(r2)
-      call h5_read(g, 'lp', p%lp(:, 1:n), ierr)
-      call h5_read(g, 'lam', p%lam(:, 1:n), ierr)
-      call h5_read(g, 'lam_old', p%lam_old(:, 1:n), ierr)
-      call h5_read(g, 'lam_prev', p%lam_prev(:, 1:n), ierr)
-      call h5_read(g, 'lam_old_prev', p%lam_old_prev(:, 1:n), ierr)
+      call h5_read(g, 'lp', p%lp(:, 1:n), ierr, cols)
+      call h5_read(g, 'lam', p%lam(:, 1:n), ierr, cols)
+      call h5_read(g, 'lam_old', p%lam_old(:, 1:n), ierr, cols)
+      call h5_read(g, 'lam_prev', p%lam_prev(:, 1:n), ierr, cols)
+      call h5_read(g, 'lam_old_prev', p%lam_old_prev(:, 1:n), ierr, cols)
       ! Checkpoints before session 12 lack it: the current volumes (what they restarted with).
       if (h5_exists(g, 'vol_fill')) then
-        call h5_read(g, 'vol_fill', p%vol_fill(1:n), ierr)
+        call h5_read(g, 'vol_fill', p%vol_fill(1:n), ierr, cols)
       else
         p%vol_fill(1:n) = p%vol(1:n)
       end if
-      deallocate(r1); allocate(r1(n)); call h5_read(g, 'mat', r1, ierr)
+      deallocate(r1); allocate(r1(n)); call h5_read(g, 'mat', r1, ierr, cols)
       p%mat(1:n) = nint(r1)
-      if (p%nstate > 0) call h5_read(g, 'state', p%state(:, 1:n), ierr)
+      if (p%nstate > 0) call h5_read(g, 'state', p%state(:, 1:n), ierr, cols)
     end associate
     call h5_close_group(g, ierr)
 
@@ -440,13 +457,14 @@ contains
         associate (sn => hist%snap(ks))
           call h5_read(gk, 'scalars', ssc, ierr)
           sn%t = ssc(1); sn%step = nint(ssc(2))
-          call read2(gk, 'x', d, np, sn%x); call read2(gk, 'v', d, np, sn%v)
-          call read2(gk, 'stress', 6, np, sn%stress)
-          call read2(gk, 'strain', 6, np, sn%strain)
-          call read1(gk, 'm', np, sn%m); call read1(gk, 'vol', np, sn%vol)
-          call read1(gk, 'rho', np, sn%rho)
-          call read2(gk, 'state', ns, np, sn%state)
-          sn%id = [(kid, kid = 1, np)] ! a checkpoint holds every particle in id order
+          call read2(gk, 'x', d, n, sn%x); call read2(gk, 'v', d, n, sn%v)
+          call read2(gk, 'stress', 6, n, sn%stress)
+          call read2(gk, 'strain', 6, n, sn%strain)
+          call read1(gk, 'm', n, sn%m); call read1(gk, 'vol', n, sn%vol)
+          call read1(gk, 'rho', n, sn%rho)
+          call read2(gk, 'state', ns, n, sn%state)
+          ! A checkpoint holds every particle in id order; dealt out, this process's ids.
+          sn%id = [(cols(1) + 1 + cols(2) * (kid - 1), kid = 1, n)]
         end associate
         call h5_close_group(gk, ierr)
       end do
@@ -459,7 +477,7 @@ contains
       integer, intent(in) :: m
       real(wp), allocatable, intent(out) :: a(:)
       allocate(a(m))
-      if (m > 0) call h5_read(loc, name, a, ierr)
+      if (m > 0) call h5_read(loc, name, a, ierr, cols)
     end subroutine read1
 
     subroutine read2(loc, name, m1, m2, a)
@@ -468,7 +486,7 @@ contains
       integer, intent(in) :: m1, m2
       real(wp), allocatable, intent(out) :: a(:,:)
       allocate(a(m1, m2))
-      if (m1 * m2 > 0) call h5_read(loc, name, a, ierr)
+      if (m1 * m2 > 0) call h5_read(loc, name, a, ierr, cols)
     end subroutine read2
   end subroutine empm_checkpoint_read
 

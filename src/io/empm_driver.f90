@@ -95,23 +95,11 @@ contains
   end function hook_stop
 
   !> Every process of `comm` takes the error of the first process that has one (or none).
-  !> Collective.
+  !> Collective ([[empm_comm_t]]'s `agree`).
   subroutine empm_agree_error(comm, e)
     type(empm_comm_t), intent(in) :: comm      !! the processes
     type(empm_error_t), intent(inout) :: e     !! this process's outcome in, the first one out
-    integer :: first, v(1)
-    character(len=:), allocatable :: text
-    if (.not. comm%parallel()) return
-    first = comm%min_int(merge(comm%rank, comm%nranks, e%code /= EMPM_OK))
-    if (first == comm%nranks) return
-    v(1) = e%code
-    call comm%bcast_ints(v, first)
-    text = ''
-    if (comm%rank == first) text = e%message
-    call comm%bcast_text(text, first)
-    if (comm%rank /= first) then
-      e%code = v(1); e%message = text
-    end if
+    call comm%agree(e)
   end subroutine empm_agree_error
 
   !> Run the case in `path`, writing HDF5 to `output` (default: the case's &output file).
@@ -168,14 +156,18 @@ contains
     type(empm_cpu_sample_t) :: load0
 
     call empm_cpu_sample(load0)
-    ! Shared among processes, the case waits for each one's share of the particles to store
-    ! its window of the grid and its basis (a restart replaces the particles: it is set up
-    ! whole, as before).
+    ! Shared among processes, each stores its share of the particles (a restart reads its
+    ! share from the checkpoint), then its window of the grid and its basis.
     resumed = .false.
     if (present(restart)) resumed = len_trim(restart) > 0
     shared = .false.
-    if (present(comm)) shared = comm%parallel() .and. .not. resumed
-    call empm_read_case(path, cs, e, extra_groups=extra_groups, shared=shared)
+    if (present(comm)) shared = comm%parallel()
+    ! Shared, each process stores its share of the particles only (collective).
+    if (shared) then
+      call empm_read_case(path, cs, e, extra_groups=extra_groups, shared=shared, comm=comm)
+    else
+      call empm_read_case(path, cs, e, extra_groups=extra_groups, shared=shared)
+    end if
     ! Each process reads the case: one that cannot (a file missing on its machine) must not
     ! leave the others waiting. All take the error of the first process that has one.
     if (present(comm)) call empm_agree_error(comm, e)
@@ -196,11 +188,11 @@ contains
     else if (present(auto_threads)) then
       if (auto_threads) call choose_threads()
     end if
-    if (shared) then
+    if (shared .and. .not. resumed) then
       ! Each process takes its share of the particles, its window of the grid, and checks its
       ! share's shape functions: the set-up a serial run finishes in empm_read_case, before
       ! the output is claimed (an unfit case is the same input error, exit 2).
-      call empm_partition_particles(cs%model, e)
+      call empm_partition_particles(cs%model, e, dealt=.true.)
       if (e%code == EMPM_OK) call empm_check_basis(path, cs, e)
       call empm_agree_error(cs%model%comm, e)
       if (e%code /= EMPM_OK) then
@@ -225,9 +217,11 @@ contains
     hook%prev = empm_checkpoint_path(cs%output_file, prev=.true.)
     hook%case_text = cs%text
     if (resumed) then
-      ! Every process reads the whole checkpoint (written by any number of processes: it
-      ! holds every particle in id order), then takes its share below.
-      call empm_checkpoint_read(trim(restart), cs%model, hist, sst, cs%text, warning, e)
+      ! The checkpoint (written by any number of processes) holds every particle in id
+      ! order: each process reads the columns of the particles dealt to it, then they move to
+      ! the processes of their boxes below.
+      call empm_checkpoint_read(trim(restart), cs%model, hist, sst, cs%text, warning, e, &
+                                dealt=cs%deal)
       call empm_agree_error(cs%model%comm, e)
       if (e%code /= EMPM_OK) then
         call release()
@@ -237,7 +231,11 @@ contains
         write(error_unit, '(a)') 'empm: note: '//warning
     end if
     if (cs%model%comm%parallel()) then
-      if (.not. shared) call empm_partition_particles(cs%model, e, hist)
+      if (resumed) then
+        call empm_partition_particles(cs%model, e, dealt=.true.)
+        if (e%code == EMPM_OK) call empm_check_basis(path, cs, e)
+        call empm_agree_error(cs%model%comm, e)
+      end if
       if (e%code /= EMPM_OK) then
         call release(); call empm_raise_error(e, err); return
       end if

@@ -9,7 +9,7 @@ module empm_h5
     h5open_f, h5fopen_f, h5fclose_f, h5fis_hdf5_f, H5F_ACC_RDONLY_F, h5lexists_f, h5dopen_f, &
     h5dget_space_f, h5sget_simple_extent_ndims_f, h5sget_simple_extent_dims_f, h5dread_f, &
     h5aopen_f, h5aget_type_f, h5tget_size_f, h5aread_f, h5aexists_f, h5sselect_hyperslab_f, &
-    h5sselect_none_f, H5S_SELECT_SET_F, H5P_DEFAULT_F
+    h5sselect_none_f, H5S_SELECT_SET_F, H5P_DEFAULT_F, H5S_ALL_F
   use empm_kinds, only: wp
   implicit none
   private
@@ -312,43 +312,69 @@ contains
     if (bad /= 0) ierr = 1
   end subroutine h5_dims
 
-  !> Read the rank-1 dataset `name` into `a` (sized to the dataset, see [[h5_dims]]).
-  subroutine read_r1(loc, name, a, ierr)
+  !> Read the rank-1 dataset `name` into `a` (sized to the dataset, see [[h5_dims]]); with
+  !> `cols` = (first, stride), the entries first, first + stride, ... (0-based) only, as many
+  !> as `a` holds.
+  subroutine read_r1(loc, name, a, ierr, cols)
     integer(hid_t), intent(in) :: loc        !! file or group
     character(len=*), intent(in) :: name     !! dataset
     real(wp), intent(inout) :: a(:)          !! values (contiguous, the dataset's shape)
     integer, intent(inout) :: ierr           !! set non-zero on failure
+    integer, intent(in), optional :: cols(2) !! first column (0-based) and stride
     integer(hsize_t) :: dims(1)
-    integer(hid_t) :: did
-    integer :: e(3)
-    dims = shape(a, kind=hsize_t); e = 0
-    call h5dopen_f(loc, name, did, e(1))
-    if (e(1) /= 0) then
-      ierr = 1; return
-    end if
-    call h5dread_f(did, H5T_NATIVE_DOUBLE, a, dims, e(2))
-    call h5dclose_f(did, e(3))
-    if (any(e /= 0)) ierr = 1
+    dims = shape(a, kind=hsize_t)
+    call read_any(loc, name, dims, ierr, cols, r1=a)
   end subroutine read_r1
 
-  !> Read the rank-2 dataset `name` into `a` (sized to the dataset in Fortran order).
-  subroutine read_r2(loc, name, a, ierr)
+  !> Read the rank-2 dataset `name` into `a` (sized to the dataset in Fortran order); with
+  !> `cols` = (first, stride), its columns first, first + stride, ... (0-based) only.
+  subroutine read_r2(loc, name, a, ierr, cols)
     integer(hid_t), intent(in) :: loc        !! file or group
     character(len=*), intent(in) :: name     !! dataset
     real(wp), intent(inout) :: a(:,:)        !! values (contiguous, the dataset's shape)
     integer, intent(inout) :: ierr           !! set non-zero on failure
+    integer, intent(in), optional :: cols(2) !! first column (0-based) and stride
     integer(hsize_t) :: dims(2)
-    integer(hid_t) :: did
-    integer :: e(3)
-    dims = shape(a, kind=hsize_t); e = 0
+    dims = shape(a, kind=hsize_t)
+    call read_any(loc, name, dims, ierr, cols, r2=a)
+  end subroutine read_r2
+
+  ! The reading of read_r1 and read_r2: the whole dataset, or the columns `cols` selects
+  ! (the last extent's, a strided hyperslab of the dataset's space; `dims` the buffer's).
+  subroutine read_any(loc, name, dims, ierr, cols, r1, r2)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer(hsize_t), intent(in) :: dims(:)
+    integer, intent(inout) :: ierr
+    integer, intent(in), optional :: cols(2)
+    real(wp), intent(inout), optional :: r1(:), r2(:,:)
+    integer(hsize_t) :: start(size(dims)), stride(size(dims))
+    integer(hid_t) :: did, fsid, msid
+    integer :: e(7), r
+    e = 0; r = size(dims)
     call h5dopen_f(loc, name, did, e(1))
     if (e(1) /= 0) then
       ierr = 1; return
     end if
-    call h5dread_f(did, H5T_NATIVE_DOUBLE, a, dims, e(2))
-    call h5dclose_f(did, e(3))
+    fsid = H5S_ALL_F; msid = H5S_ALL_F
+    if (present(cols)) then
+      if (product(dims) == 0) then
+        call h5dclose_f(did, e(2)); return
+      end if
+      call h5dget_space_f(did, fsid, e(2))
+      start = 0; start(r) = cols(1)
+      stride = 1; stride(r) = cols(2)
+      call h5sselect_hyperslab_f(fsid, H5S_SELECT_SET_F, start, dims, e(3), stride=stride)
+      call h5screate_simple_f(r, dims, msid, e(4))
+    end if
+    if (present(r1)) call h5dread_f(did, H5T_NATIVE_DOUBLE, r1, dims, e(5), msid, fsid)
+    if (present(r2)) call h5dread_f(did, H5T_NATIVE_DOUBLE, r2, dims, e(5), msid, fsid)
+    if (present(cols)) then
+      call h5sclose_f(fsid, e(6)); call h5sclose_f(msid, e(7))
+    end if
+    call h5dclose_f(did, e(2))
     if (any(e /= 0)) ierr = 1
-  end subroutine read_r2
+  end subroutine read_any
 
   !> Read the string attribute `name` of `loc` (a fixed-length string, as [[h5_attr]] writes
   !> it); `ierr` set non-zero when it is missing or not a string.

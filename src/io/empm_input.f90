@@ -25,7 +25,10 @@ module empm_input
   use empm_model, only: empm_material_slot_t
   use empm_loads, only: RAMP_NONE, RAMP_SINE, RAMP_LINEAR, empm_traction_t, empm_geostatic_stress
   use empm_extension, only: EXT_THETA_DEFAULT
-  use empm_particle_gen, only: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
+  use empm_particle_gen, only: empm_fill, empm_deal_t, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, &
+    PLACE_VOXEL
+  use empm_comm, only: empm_comm_t
+  use empm_partition, only: empm_list_loaded
   use empm_shape, only: shape_status_text
   use empm_registry, only: empm_registry_t, empm_default_registry
   use empm_solver, only: empm_run_params
@@ -250,7 +253,7 @@ contains
   !> Read, validate and set up the case in `path`. On error, `err` (or a stop with status 2)
   !> names the file, the line, the group and the key. `extra_groups` (blank-separated) are
   !> groups the caller reads itself (e.g. 'verify'): they are skipped, not rejected.
-  subroutine empm_read_case(path, cs, err, overrides, registry, extra_groups, shared)
+  subroutine empm_read_case(path, cs, err, overrides, registry, extra_groups, shared, comm)
     character(len=*), intent(in) :: path                      !! case file
     type(empm_case_t), intent(inout) :: cs                    !! the case, ready to run
     type(empm_error_t), intent(out), optional :: err          !! error, if present
@@ -265,6 +268,10 @@ contains
                                                               !! call empm_partition_particles,
                                                               !! then [[empm_check_basis]]
                                                               !! (docs/parallel.md)
+    type(empm_comm_t), intent(in), optional :: comm           !! with `shared`: the processes
+                                                              !! (collective); each generates
+                                                              !! every particle and stores its
+                                                              !! share of them only
     type(empm_overrides_t) :: ov
     type(empm_registry_t) :: reg
     type(empm_group_t), allocatable :: gs(:)
@@ -282,9 +289,19 @@ contains
     extra = ''
     if (present(extra_groups)) extra = extra_groups
     cs%file = path
+    if (present(comm) .and. present(shared)) then
+      if (shared .and. comm%parallel()) then
+        cs%model%comm = comm
+        cs%deal = empm_deal_t(every=comm%nranks, rank=comm%rank)
+      end if
+    end if
     call empm_read_text(path, cs%text, e)
-    if (e%code /= EMPM_OK) then
+    if (e%code /= EMPM_OK) &
       call e%set(EMPM_ERR_INPUT, 'cannot open case file: '//e%message, file=path)
+    ! Dealt out among processes (cs%deal), the reading has collective steps: an error only one
+    ! process has (a file missing on its machine, its memory) is everyone's before them.
+    call cs%model%comm%agree(e)
+    if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
     end if
     call empm_parse_namelist(cs%text, path, gs, e)
@@ -293,6 +310,7 @@ contains
     if (e%code == EMPM_OK) call read_materials(path, gs, cs, reg, e)
     if (e%code == EMPM_OK) call read_shape(gs, cs, ov, reg, e)
     if (e%code == EMPM_OK) call read_particles(path, gs, cs, ov, e)
+    call cs%model%comm%agree(e)
     if (e%code == EMPM_OK) call read_integrator(path, gs, cs, ov, reg, e)
     if (e%code == EMPM_OK) call read_loads(gs, cs, e)
     if (e%code == EMPM_OK) call apply_geostatic(gs, cs, e)
@@ -625,12 +643,12 @@ contains
       if (e%code /= EMPM_OK) return
       p0 = cs%model%pts%np
       call empm_fill(cs%model%pts, cs%model%grid, geom, lo, hi, center, radius, ppc, place, &
-        cs%model%mats(imat)%model%rho0, imat, nadded, info)
+        cs%model%mats(imat)%model%rho0, imat, nadded, info, deal=cs%deal)
       if (nadded == 0) then
         call g%fail(e, '', 'body '//str(nbody)//': the geometry contains no particle '// &
           'position of the grid: check lo/hi or center/radius against &grid'); return
       end if
-      do q = p0 + 1, p0 + nadded
+      do q = p0 + 1, cs%model%pts%np
         associate (x => cs%model%pts%x(:, q))
           cs%model%pts%v(:, q) = velocity(1:nd) + amp(1:nd) * &
             sin(sum(wavenumber(1:nd) * x) + phase)
@@ -650,7 +668,8 @@ contains
         'center', 'radius', 'placement']
       character(len=:), allocatable :: full
       real(wp) :: lp(3)
-      integer :: j
+      integer :: j, id
+      logical :: mine
       if (.not. g%has('file') .or. len_trim(file) == 0) then
         call g%fail(e, 'file', 'required for geometry = ''file'': a point list (.csv, .h5) '// &
           'or a Gmsh mesh (.msh) (body '//str(nbody)//')'); return
@@ -678,15 +697,16 @@ contains
         call g%fail(e, 'stress', 'the file '''//file//''' gives stresses: give them there '// &
           'or with the stress key, not both (body '//str(nbody)//')'); return
       end if
-      p0 = cs%model%pts%np
       do j = 1, body%n
+        call cs%deal%next(id, mine)
+        if (.not. mine) cycle
         ! uGIMP half-lengths: half the side of the cube (square, segment) of the volume.
         lp = 0.0_wp
         lp(1:nd) = 0.5_wp * body%vol(j)**(1.0_wp / nd)
         call cs%model%pts%append(body%x(:, j), body%vol(j), cs%model%mats(imat)%model%rho0, &
-          lp(1:nd), imat, e)
+          lp(1:nd), imat, e, id=id)
         if (e%code /= EMPM_OK) return
-        q = p0 + j
+        q = cs%model%pts%np
         if (body%has_velocity) then
           cs%model%pts%v(:, q) = body%v(:, j)
         else
@@ -738,7 +758,8 @@ contains
   ! multipliers: 7 ndim values; masses, volumes, densities: 4; stress, strain: 12; F: 9; the
   ! state variables; the material index), the solver's copy of the last good state (as much
   ! again), the shape-function basis (max_nodes node indices, values and ndim gradients) and
-  ! scratch; refused (key ppc) when above the machine's physical memory.
+  ! scratch; refused (key ppc) when above the machine's physical memory (for a case shared by
+  ! place among processes, one process's share of the particles with the whole grid).
   subroutine check_particle_memory(g, cs, np, e)
     type(empm_group_t), intent(in) :: g
     type(empm_case_t), intent(in) :: cs
@@ -746,6 +767,7 @@ contains
     type(empm_error_t), intent(inout) :: e
     integer(int64) :: per, maxn, nnode, bytes, mem, nstate
     integer :: nd, im
+    character(len=:), allocatable :: share
     nd = cs%model%grid%ndim
     nstate = 0
     do im = 1, size(cs%model%mats)
@@ -755,15 +777,21 @@ contains
     per = 2_int64 * (8_int64 * (7_int64 * nd + 25_int64 + nstate) + 4_int64) + &
       maxn * (4_int64 + 8_int64 + 8_int64 * nd) + 4_int64 + 8_int64 * (2_int64 * nd + 1_int64)
     nnode = product(int(cs%model%grid%ncell(1:nd), int64) + 1_int64)
-    bytes = np * per + nnode * (8_int64 + 52_int64 * nd)
+    ! Shared by place among processes, each stores its share (cs%deal).
+    share = ''
+    if (cs%deal%every > 1) share = ' (each of the '//str(cs%deal%every)//' processes about '// &
+      i64(np / cs%deal%every)//')'
+    bytes = (np / cs%deal%every) * per + nnode * (8_int64 + 52_int64 * nd)
     mem = empm_physical_memory()
     if (np > int(huge(1), int64)) then
       call g%fail(e, 'ppc', 'the bodies would have about '//i64(np)// &
         ' particles, more than '//str(huge(1))//' (particle numbers are default integers)')
     else if (mem > 0 .and. bytes > mem) then
       call g%fail(e, 'ppc', 'the bodies would have about '//i64(np)// &
-        ' particles, which with the grid need about '//str_short(real(bytes, wp) / 2.0_wp**30)// &
-        ' GiB ('//i64(bytes)//' bytes), more than this machine''s '// &
+        ' particles'//share//', which with the grid need about '// &
+        str_short(real(bytes, wp) / 2.0_wp**30)// &
+        ' GiB'//trim(merge(' each', '     ', cs%deal%every > 1))//' ('//i64(bytes)// &
+        ' bytes), more than this machine''s '// &
         str_short(real(mem, wp) / 2.0_wp**30)//' GiB ('//i64(mem)//' bytes)')
     end if
   contains
@@ -984,7 +1012,7 @@ contains
     character(len=*), intent(in) :: mirror
     integer, intent(in) :: nb
     type(empm_error_t), intent(inout) :: e
-    integer :: a, side, nsel, info, p, np
+    integer :: a, side, nsel, info, p, np, bad
     real(wp) :: plane, tol
     a = index('xyz', mirror(2:2)); side = merge(-a, a, mirror(1:1) == '-')
     if (a > cs%model%grid%ndim) then
@@ -1016,13 +1044,19 @@ contains
     end select
     ! The ghost side must hold no particle (the mirror stands for the body's image there).
     plane = lo(a); tol = 1.0e-9_wp * cs%model%grid%h(a)
+    ! The first such particle (lowest id, over every process when the set is dealt out).
     np = cs%model%pts%np
+    bad = huge(1)
     do p = 1, np
       if (sign(1.0_wp, real(side, wp)) * (cs%model%pts%x(a, p) - plane) > tol) then
-        call g%fail(e, 'mirror', 'particle '//str(p)//' lies on the ghost side '//mirror// &
-          ' of the plane at '//str_short(plane)//' m (boundary '//str(nb)//')'); return
+        bad = cs%model%pts%id(p); exit
       end if
     end do
+    bad = cs%model%comm%min_int(bad)
+    if (bad < huge(1)) then
+      call g%fail(e, 'mirror', 'particle '//str(bad)//' lies on the ghost side '//mirror// &
+        ' of the plane at '//str_short(plane)//' m (boundary '//str(nb)//')'); return
+    end if
   end subroutine read_mirror
 
   !> A name that can be an HDF5 group: 1..64 of NAME_CHARS, not '.' or '..'.
@@ -1053,10 +1087,12 @@ contains
           surf = merge(cs%body_hi(a, b), -cs%body_lo(a, b), gv(a) < 0.0_wp)
           call empm_geostatic_stress(nd, grid%origin, grid%h, pts%x(:, i0:i1), &
             pts%lp(:, i0:i1), pts%rho(i0:i1), gv, cs%body_k0(b), pts%stress(:, i0:i1), info, &
-            surface=surf)
+            surface=surf, comm=cs%model%comm)
         else
+          ! Dealt out among processes (cs%deal), the columns' tops are agreed.
           call empm_geostatic_stress(nd, grid%origin, grid%h, pts%x(:, i0:i1), &
-            pts%lp(:, i0:i1), pts%rho(i0:i1), gv, cs%body_k0(b), pts%stress(:, i0:i1), info)
+            pts%lp(:, i0:i1), pts%rho(i0:i1), gv, cs%body_k0(b), pts%stress(:, i0:i1), info, &
+            comm=cs%model%comm)
         end if
       end associate
       if (info == 1) then
@@ -1080,7 +1116,8 @@ contains
     type(empm_traction_t), allocatable :: trs(:)
     character(len=:), allocatable :: name, body, face, ramp
     real(wp) :: lo(3), hi(3), pressure, trac(3), ramp_time, tol, plane
-    integer :: k, nt, nd, nlo, nhi, n, ib, i0, i1, q, ax, d, cnt
+    integer :: k, nt, nd, nlo, nhi, n, ib, i0, i1, q, ax, d, cnt, bad, badid
+    character(len=:), allocatable :: text
     allocate(p, source=empm_input_group_params('traction'))
     nd = cs%model%grid%ndim
     tol = 1.0e-9_wp * cs%model%grid%hmin()
@@ -1154,38 +1191,51 @@ contains
         if (ib > 0) then
           i0 = cs%body_first(ib); i1 = cs%body_last(ib)
         end if
-        associate (x => cs%model%pts%x)
+        ! The particles in the box (this process's, when the set is dealt out: cs%deal).
+        associate (x => cs%model%pts%x, pts => cs%model%pts)
           cnt = 0
           do q = i0, i1
             if (all(x(1:nd, q) >= lo(1:nd) - tol .and. x(1:nd, q) <= hi(1:nd) + tol)) cnt = cnt + 1
           end do
-          if (cnt == 0) then
+          if (cs%model%comm%sum_int(cnt) == 0) then
             call g%fail(e, 'lo', 'the box [lo, hi] selects no particle ('//name//')'); return
           end if
           allocate(tr%part(cnt), tr%area(cnt), tr%offset(cnt))
           ! The loaded plane is the box's outer side; every particle must lie within its own
-          ! size 2 lp of it (the outer layer only).
+          ! size 2 lp of it (the outer layer only). The first one that does not (lowest id) is
+          ! reported.
           plane = merge(hi(ax), lo(ax), tr%side > 0)
-          cnt = 0
+          cnt = 0; bad = 0
           do q = i0, i1
             if (all(x(1:nd, q) >= lo(1:nd) - tol .and. x(1:nd, q) <= hi(1:nd) + tol)) then
               cnt = cnt + 1; tr%part(cnt) = q
               tr%offset(cnt) = max(tr%side * (plane - x(ax, q)), 0.0_wp)
-              if (tr%offset(cnt) > 2.0_wp * cs%model%pts%lp(ax, q) + tol) then
-                call g%fail(e, merge('lo', 'hi', tr%side > 0), 'particle '//str(q)// &
-                  ' lies '//str(tr%offset(cnt))//' m inside the loaded face (the box''s '// &
-                  merge('upper', 'lower', tr%side > 0)//' side along '//face(2:2)// &
-                  '), more than its size '//str(2.0_wp * cs%model%pts%lp(ax, q))// &
-                  ': the box must select the outer layer of particles only ('//name//')')
-                return
-              end if
+              if (tr%offset(cnt) > 2.0_wp * pts%lp(ax, q) + tol .and. bad == 0) bad = q
               ! Face area: the domain's side lengths across the normal (per unit thickness).
               tr%area(cnt) = 1.0_wp
               do d = 1, nd
-                if (d /= ax) tr%area(cnt) = tr%area(cnt) * 2.0_wp * cs%model%pts%lp(d, q)
+                if (d /= ax) tr%area(cnt) = tr%area(cnt) * 2.0_wp * pts%lp(d, q)
               end do
             end if
           end do
+          badid = huge(1)
+          if (bad > 0) badid = pts%id(bad)
+          badid = cs%model%comm%min_int(badid)
+          if (badid < huge(1)) then
+            if (bad > 0) then
+              if (pts%id(bad) == badid) then
+                text = 'particle '//str(badid)//' lies '// &
+                  str(max(tr%side * (plane - x(ax, bad)), 0.0_wp))// &
+                  ' m inside the loaded face (the box''s '// &
+                  merge('upper', 'lower', tr%side > 0)//' side along '//face(2:2)// &
+                  '), more than its size '//str(2.0_wp * pts%lp(ax, bad))// &
+                  ': the box must select the outer layer of particles only ('//name//')'
+              end if
+            end if
+            call cs%model%comm%bcast_text(text, mod(badid - 1, cs%deal%every))
+            call g%fail(e, merge('lo', 'hi', tr%side > 0), text); return
+          end if
+          if (cs%deal%every > 1) call empm_list_loaded(cs%model, tr)
         end associate
       end associate
     end do
@@ -1199,8 +1249,9 @@ contains
     type(empm_param_t), allocatable :: p(:)
     type(empm_group_t) :: g
     character(len=:), allocatable :: name
-    integer :: particle, n, nd, q, k, npt
-    real(wp) :: point(3)
+    integer :: particle, n, nd, q, k, npt, i
+    real(wp) :: point(3), dmin
+    real(wp), allocatable :: dist(:)
     character(len=64), allocatable :: names(:)
     integer, allocatable :: parts(:)
     allocate(p, source=empm_input_group_params('probe'))
@@ -1232,9 +1283,10 @@ contains
         call g%fail(e, 'particle', 'give exactly one of particle (index) or point '// &
           '(coordinates) for probe '''//name//''''); return
       end if
+      ! Particles by id (generation order; cs%deal%n of them, on every process together).
       if (g%has('particle')) then
-        if (particle > cs%model%pts%np) then
-          call g%fail(e, 'particle', 'expected 1..'//str(cs%model%pts%np)//', got '// &
+        if (particle > cs%deal%n) then
+          call g%fail(e, 'particle', 'expected 1..'//str(cs%deal%n)//', got '// &
             str(particle)); return
         end if
         q = particle
@@ -1242,9 +1294,22 @@ contains
         if (npt < nd) then
           call g%fail(e, 'point', 'expected '//str(nd)//' coordinates'); return
         end if
-        ! A point probe follows the material point nearest to it at t = 0.
-        q = minloc(sum((cs%model%pts%x(:, 1:cs%model%pts%np) - &
-                   spread(point(1:nd), 2, cs%model%pts%np))**2, dim=1), dim=1)
+        ! A point probe follows the material point nearest to it at t = 0 (the lowest id of
+        ! the nearest).
+        associate (pts => cs%model%pts, comm => cs%model%comm)
+          dist = sum((pts%x(:, 1:pts%np) - spread(point(1:nd), 2, pts%np))**2, dim=1)
+          q = huge(1)
+          if (pts%np > 0) then
+            i = minloc(dist, dim=1)
+            dmin = comm%min_real(dist(i))
+          else
+            dmin = comm%min_real(huge(1.0_wp))
+          end if
+          if (pts%np > 0) then
+            if (dist(i) == dmin) q = pts%id(i)
+          end if
+          q = comm%min_int(q)
+        end associate
       end if
       names = [character(len=64) :: names, name]; parts = [parts, q]
     end do

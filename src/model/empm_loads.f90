@@ -15,6 +15,7 @@
 !> (`offset`; the face moves with the particle), rather than at the particle.
 module empm_loads
   use empm_kinds, only: wp, pi
+  use empm_comm, only: empm_comm_t
   implicit none
   private
   public :: empm_loads_t, empm_body_force_t, empm_traction_t, RAMP_NONE, RAMP_SINE, RAMP_LINEAR
@@ -133,7 +134,10 @@ contains
   !> q in that column, i.e. the upper face of the column's highest particle; or, with
   !> `surface`, that elevation for every column (a flat top known exactly, e.g. a box's). `info`
   !> = 1 when g is zero or not along one axis, 2 when the body spans more than 1e8 columns.
-  pure subroutine empm_geostatic_stress(nd, origin, h, x, lp, rho, g, k0, stress, info, surface)
+  !> With `comm`, the body's particles are those of every process (each passes its own): the
+  !> columns and their tops are agreed (collective), as if one process held them all.
+  subroutine empm_geostatic_stress(nd, origin, h, x, lp, rho, g, k0, stress, info, surface, &
+                                   comm)
     integer, intent(in) :: nd               !! spatial dimension
     real(wp), intent(in) :: origin(:)       !! grid origin (>= nd) [m]
     real(wp), intent(in) :: h(:)            !! grid spacing (>= nd) [m]
@@ -145,7 +149,9 @@ contains
     real(wp), intent(out) :: stress(:,:)    !! Cauchy stress, Voigt (6, n) [Pa]
     integer, intent(out) :: info            !! 0 ok, 1 bad gravity, 2 too many columns
     real(wp), intent(in), optional :: surface !! elevation of a flat top (along −g) [m]
+    type(empm_comm_t), intent(in), optional :: comm !! the processes sharing the body
     integer :: a, up, n, p, d, k, nh, hd(2), lo(2), ext(2)
+    logical :: shared
     real(wp) :: gabs, z
     real(wp), allocatable :: top(:)
     info = 0; n = size(x, 2)
@@ -155,7 +161,9 @@ contains
     end if
     a = findloc(g(1:nd) /= 0.0_wp, .true., dim=1)
     gabs = abs(g(a)); up = -int(sign(1.0_wp, g(a)))
-    if (n == 0) return
+    shared = .false.
+    if (present(comm)) shared = comm%parallel()
+    if (n == 0 .and. .not. shared) return
     ! Horizontal axes and the index box of the body's columns.
     nh = 0; hd = 0; lo = 0; ext = 1
     do d = 1, nd
@@ -164,8 +172,12 @@ contains
     end do
     do k = 1, nh
       d = hd(k)
-      lo(k) = minval(floor((x(d, 1:n) - origin(d)) / h(d)))
-      ext(k) = maxval(floor((x(d, 1:n) - origin(d)) / h(d))) - lo(k) + 1
+      lo(k) = minval(floor((x(d, 1:n) - origin(d)) / h(d)))      ! huge(1) when n = 0
+      ext(k) = maxval(floor((x(d, 1:n) - origin(d)) / h(d)))     ! −huge(1) when n = 0
+      if (shared) then
+        lo(k) = comm%min_int(lo(k)); ext(k) = comm%max_int(ext(k))
+      end if
+      ext(k) = ext(k) - lo(k) + 1
     end do
     if (real(ext(1), wp) * real(ext(2), wp) > 1.0e8_wp) then
       info = 2; return
@@ -179,6 +191,7 @@ contains
         k = column(p)
         top(k) = max(top(k), up * x(a, p) + lp(a, p))
       end do
+      if (shared) call comm%max_reals(top)
     end if
     do p = 1, n
       z = up * x(a, p)

@@ -6,12 +6,13 @@ module empm_partition
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, empm_raise_error
   use empm_model, only: empm_model_t
+  use empm_loads, only: empm_traction_t
   use empm_history, only: empm_history_t, empm_snapshot_t
   use empm_decomp, only: empm_rcb, empm_cell_of, empm_box_owner
   implicit none
   private
   public :: empm_partition_particles, empm_share_traction_state, empm_gather_particles, empm_rebalance
-  public :: empm_copy_for_output
+  public :: empm_copy_for_output, empm_list_loaded
 
 contains
 
@@ -19,12 +20,17 @@ contains
   !> set before: the case read, or a checkpoint read, on each). The particles keep their ids,
   !> which order them in the output; nodal masses and the empty-node threshold are those of
   !> the whole set. Serial: nothing changes.
-  subroutine empm_partition_particles(model, err, hist)
+  subroutine empm_partition_particles(model, err, hist, dealt)
     type(empm_model_t), intent(inout) :: model          !! model (set up)
     type(empm_error_t), intent(inout), optional :: err  !! allocation failure, if present
     type(empm_history_t), intent(inout), optional :: hist !! a record with snapshots of every
                                                         !! particle (a checkpoint's): they keep
                                                         !! this process's particles too
+    logical, intent(in), optional :: dealt              !! each process holds a share of the
+                                                        !! particles (the case read with a
+                                                        !! communicator: `empm_read_case`),
+                                                        !! not every one: they move to the
+                                                        !! process of their box (collective)
     type(empm_error_t) :: e
     integer, allocatable :: counts(:), mine(:), owner(:)
     integer :: lo(3, model%comm%nranks), hi(3, model%comm%nranks), nc(3)
@@ -36,8 +42,26 @@ contains
         call model%set_runs(err)
       return
     end if
-    ! Every process holds every particle here: its own counts are the whole run's.
     call cell_counts(model, nc, counts)
+    if (present(dealt)) then
+      if (dealt) then
+        ! Each process holds a share: the counts, and the lightest particle, are everyone's.
+        call model%comm%sum_counts(counts)
+        call empm_rcb(model%grid%ndim, nc(1:model%grid%ndim), counts, model%comm%nranks, lo, hi)
+        mass_tol = huge(1.0_wp)
+        if (model%pts%np > 0) mass_tol = model%nodes%mass_tol
+        model%nodes%mass_tol = model%comm%min_real(mass_tol)
+        call move_particles(model, owners(model, lo, hi), e)
+        if (e%code /= 0) then
+          call empm_raise_error(e, err); return
+        end if
+        call keep_boxes(model, lo, hi)
+        model%boxes0 = model%boxes
+        call model%share_region()
+        return
+      end if
+    end if
+    ! Every process holds every particle here: its own counts are the whole run's.
     call empm_rcb(model%grid%ndim, nc(1:model%grid%ndim), counts, model%comm%nranks, lo, hi)
     owner = owners(model, lo, hi)
     n = count(owner == model%comm%rank)
@@ -120,14 +144,12 @@ contains
     integer, intent(out) :: migrated                    !! particles that changed process
     type(empm_error_t), intent(inout), optional :: err  !! allocation failure, if present
     type(empm_error_t) :: e
-    real(wp), allocatable :: rows(:,:), got(:,:), srt(:,:)
-    integer, allocatable :: counts(:), dest(:), order(:)
+    integer, allocatable :: counts(:), dest(:)
     integer :: lo(3, model%comm%nranks), hi(3, model%comm%nranks), nc(3)
-    integer :: p, np, m, oid, nd, ns, n
-    real(wp) :: mass_tol
+    integer :: nd
     before = 1.0_wp; static = 1.0_wp; moved = .false.; migrated = 0
     if (.not. model%comm%parallel() .or. .not. allocated(model%boxes)) return
-    np = model%pts%np; nd = model%grid%ndim; ns = model%pts%nstate
+    nd = model%grid%ndim
     call cell_counts(model, nc, counts)
     call model%comm%sum_counts(counts)
     before = share(model%boxes)
@@ -138,25 +160,10 @@ contains
     dest = owners(model, lo, hi)
     migrated = model%comm%sum_int(count(dest /= model%comm%rank))
     if (migrated == 0) return
-    m = model%pts%row_size()
-    allocate(rows(m, np))
-    call model%pts%pack_rows([(p, p = 1, np)], rows)
-    call model%comm%exchange_rows(rows, np, dest, got)
-    ! In id order, as the set was made (runs of one material stay together).
-    oid = model%pts%id_row()
-    n = size(got, 2)
-    order = id_order(nint(got(oid, 1:n)))
-    allocate(srt(m, n))
-    srt = got(:, order)
-    mass_tol = model%nodes%mass_tol
-    call model%pts%set_from_rows(nd, ns, srt, n, e)
-    if (e%code == 0) call model%set_runs(e)
+    call move_particles(model, dest, e)
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
-    model%nodes%mass_tol = mass_tol
-    call empm_share_traction_state(model)
-    call map_tractions(model)
     moved = .true.
 
   contains
@@ -180,6 +187,50 @@ contains
     end function share
   end subroutine empm_rebalance
 
+  ! Every particle to process dest(p), each process's then in id order, as the set was made
+  ! (runs of one material stay together), with the storage of their basis; the empty-node
+  ! threshold kept; tractions follow their particles by id. Collective.
+  subroutine move_particles(model, dest, e)
+    type(empm_model_t), intent(inout) :: model
+    integer, intent(in) :: dest(:)
+    type(empm_error_t), intent(inout) :: e
+    real(wp), allocatable :: rows(:,:), got(:,:)
+    integer, allocatable :: order(:), first(:), perm(:)
+    integer :: p, np, m, n, nd, ns
+    real(wp) :: mass_tol
+    np = model%pts%np; nd = model%grid%ndim; ns = model%pts%nstate
+    m = model%pts%row_size()
+    ! Packed grouped by destination (each group in this process's order), so that the exchange
+    ! sends the rows as they are; at most two copies of a process's particles at a time: the
+    ! storage goes once packed.
+    allocate(rows(m, np), first(0:model%comm%nranks), perm(np))
+    first = 0
+    do p = 1, np
+      first(dest(p)) = first(dest(p)) + 1
+    end do
+    first = eoshift(first, -1)
+    do p = 1, model%comm%nranks
+      first(p) = first(p) + first(p - 1)
+    end do
+    do p = 1, np
+      first(dest(p)) = first(dest(p)) + 1
+      perm(first(dest(p))) = p
+    end do
+    call model%pts%pack_rows(perm, rows)
+    call model%pts%alloc(nd, 0, ns)
+    call model%comm%exchange_rows(rows, np, dest(perm), got)
+    deallocate(rows)
+    n = size(got, 2)
+    order = id_order(nint(got(model%pts%id_row(), 1:n)))
+    mass_tol = model%nodes%mass_tol
+    call model%pts%set_from_rows(nd, ns, got, n, e, order=order)
+    if (e%code == 0) call model%set_runs(e)
+    if (e%code /= 0) return
+    model%nodes%mass_tol = mass_tol
+    call empm_share_traction_state(model)
+    call map_tractions(model)
+  end subroutine move_particles
+
   !> Every process gets the tractions' shape-function state (λ at each face centre, which
   !> only the process holding the particle updates, as `part` still says): after the
   !> particles moved, before their entries are found again, and before the root writes a
@@ -200,31 +251,64 @@ contains
   end subroutine empm_share_traction_state
 
   ! After the particles moved: each traction entry's index on this process, from its particle's
-  ! id (a process's particles are in id order: a binary search), 0 when another holds it.
+  ! id, 0 when another holds it.
   subroutine map_tractions(model)
     type(empm_model_t), intent(inout) :: model
-    integer :: k, j, lo, hi, mid, np
+    integer :: k
     if (model%loads%ntraction() == 0) return
-    np = model%pts%np
     do k = 1, size(model%loads%tractions)
-      associate (tr => model%loads%tractions(k), id => model%pts%id)
-        do j = 1, size(tr%pid)
-          tr%part(j) = 0
-          lo = 1; hi = np
-          do while (lo <= hi)
-            mid = (lo + hi) / 2
-            if (id(mid) == tr%pid(j)) then
-              tr%part(j) = mid; exit
-            else if (id(mid) < tr%pid(j)) then
-              lo = mid + 1
-            else
-              hi = mid - 1
-            end if
-          end do
-        end do
-      end associate
+      call find_ids(model, model%loads%tractions(k))
     end do
   end subroutine map_tractions
+
+  ! `part` from `pid`: this process's index of each loaded particle (its particles are in id
+  ! order: a binary search), 0 when another process holds it.
+  subroutine find_ids(model, tr)
+    type(empm_model_t), intent(in) :: model
+    type(empm_traction_t), intent(inout) :: tr
+    integer :: j, lo, hi, mid
+    associate (id => model%pts%id)
+      do j = 1, size(tr%pid)
+        tr%part(j) = 0
+        lo = 1; hi = model%pts%np
+        do while (lo <= hi)
+          mid = (lo + hi) / 2
+          if (id(mid) == tr%pid(j)) then
+            tr%part(j) = mid; exit
+          else if (id(mid) < tr%pid(j)) then
+            lo = mid + 1
+          else
+            hi = mid - 1
+          end if
+        end do
+      end do
+    end associate
+  end subroutine find_ids
+
+  !> A traction selected on a particle set dealt out among the processes (each selected from
+  !> its own particles, `part` their indices, with their `area` and `offset`): every process
+  !> gets the whole list in id order, as one process holding every particle selects it, by id
+  !> (`pid`), with its own particles' indices in `part` and 0 for the others', as after the
+  !> partition. Collective.
+  subroutine empm_list_loaded(model, tr)
+    type(empm_model_t), intent(in) :: model     !! the model whose particles are dealt out
+    type(empm_traction_t), intent(inout) :: tr  !! the traction, selected on this process
+    real(wp), allocatable :: mine(:,:), all(:,:)
+    integer, allocatable :: ids(:), order(:)
+    integer :: j, m
+    m = size(tr%part)
+    allocate(mine(3, m))
+    do j = 1, m
+      mine(:, j) = [real(model%pts%id(tr%part(j)), wp), tr%area(j), tr%offset(j)]
+    end do
+    call model%comm%gather_rows(mine, m, all, to_all=.true.)
+    ids = nint(all(1, :))
+    order = id_order(ids)
+    tr%pid = ids(order); tr%area = all(2, order); tr%offset = all(3, order)
+    deallocate(tr%part)
+    allocate(tr%part(size(ids)))
+    call find_ids(model, tr)
+  end subroutine empm_list_loaded
 
   ! The permutation that sorts distinct integers increasingly (merge sort: n log n, stable).
   pure function id_order(key) result(idx)
@@ -325,8 +409,8 @@ contains
     type(empm_history_t), intent(inout) :: hist         !! record (its snapshots likewise)
     type(empm_error_t), intent(inout), optional :: err  !! allocation failure, if present
     logical, intent(in), optional :: blocks             !! each process a block of ids
-    real(wp), allocatable :: rows(:,:), all(:,:), sorted(:,:)
-    integer, allocatable :: dest(:)
+    real(wp), allocatable :: rows(:,:), all(:,:)
+    integer, allocatable :: dest(:), order(:)
     type(empm_error_t) :: e
     integer :: m, np, k, nd, ns, oid, first, last, ntotal
     logical :: by_block
@@ -349,18 +433,24 @@ contains
     allocate(rows(m, np))
     call model%pts%pack_rows([(k, k = 1, np)], rows)
     oid = model%pts%id_row()
+    ! At most two copies of the particles at a time: the storage goes once packed (on a
+    ! process other than the root, gathering to it, the model keeps its particles).
     if (by_block) then
       dest = [(owner(nint(rows(oid, k))), k = 1, np)]
+      call model%pts%alloc(nd, 0, ns)
       call model%comm%exchange_rows(rows, np, dest, all)
     else
       call model%comm%gather_rows(rows, np, all)
       if (.not. model%comm%is_root()) return
+      call model%pts%alloc(nd, 0, ns)
     end if
-    allocate(sorted(m, last - first + 1))
+    deallocate(rows)
+    ! Particle k of the result is id first + k − 1.
+    allocate(order(last - first + 1))
     do k = 1, size(all, 2)
-      sorted(:, nint(all(oid, k)) - first + 1) = all(:, k)
+      order(nint(all(oid, k)) - first + 1) = k
     end do
-    call model%pts%set_from_rows(nd, ns, sorted, size(sorted, 2), e)
+    call model%pts%set_from_rows(nd, ns, all, size(order), e, order=order)
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
@@ -388,7 +478,8 @@ contains
     ! taken), to the root or to the processes of their blocks.
     subroutine gather_snapshot(sn)
       type(empm_snapshot_t), intent(inout) :: sn
-      real(wp), allocatable :: r(:,:), a(:,:), srt(:,:)
+      real(wp), allocatable :: r(:,:), a(:,:)
+      integer, allocatable :: ord(:)
       integer :: mm, q, o, n
       mm = 1 + 2 * nd + 12 + 3 + ns
       n = size(sn%id) ! the particles it held then (before a re-cut, perhaps)
@@ -407,15 +498,17 @@ contains
         call model%comm%gather_rows(r, n, a)
         if (.not. model%comm%is_root()) return
       end if
-      allocate(srt(mm, last - first + 1))
+      deallocate(r)
+      ! Particle q of the snapshot is id first + q − 1, in column ord(q) of a.
+      allocate(ord(last - first + 1))
       do q = 1, size(a, 2)
-        srt(:, nint(a(1, q)) - first + 1) = a(:, q)
+        ord(nint(a(1, q)) - first + 1) = q
       end do
       o = 1 + 2 * nd
-      sn%x = srt(2:1 + nd, :); sn%v = srt(2 + nd:1 + 2 * nd, :)
-      sn%stress = srt(o + 1:o + 6, :); sn%strain = srt(o + 7:o + 12, :)
-      sn%m = srt(o + 13, :); sn%vol = srt(o + 14, :); sn%rho = srt(o + 15, :)
-      sn%state = srt(o + 16:o + 15 + ns, :)
+      sn%x = a(2:1 + nd, ord); sn%v = a(2 + nd:1 + 2 * nd, ord)
+      sn%stress = a(o + 1:o + 6, ord); sn%strain = a(o + 7:o + 12, ord)
+      sn%m = a(o + 13, ord); sn%vol = a(o + 14, ord); sn%rho = a(o + 15, ord)
+      sn%state = a(o + 16:o + 15 + ns, ord)
       sn%id = [(q, q = first, last)]
     end subroutine gather_snapshot
   end subroutine empm_gather_particles

@@ -8,7 +8,7 @@ module empm_particle_gen
   use empm_error, only: empm_error_t
   implicit none
   private
-  public :: empm_fill, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
+  public :: empm_fill, empm_deal_t, GEOM_BOX, GEOM_DISK, PLACE_GAUSS, PLACE_VOXEL
 
   integer, parameter :: GEOM_BOX = 1     !! axis-aligned box [lo, hi] (interval in 1D)
   integer, parameter :: GEOM_DISK = 2    !! disk (2D) or ball (3D) of given centre and radius
@@ -17,7 +17,29 @@ module empm_particle_gen
   !> A box face within this fraction of a cell of a grid line is taken to be on it.
   real(wp), parameter :: SLIVER = 1.0e-9_wp
 
+  !> Generated particles dealt out to the processes of a run that will share them by place
+  !> (docs/parallel.md, "Set-up"): every process generates the whole sequence, and particle k
+  !> of it (its id) is stored by process mod(k − 1, every) only, so that no process holds
+  !> every particle. One process (`every` = 1) stores them all, with the same ids.
+  type :: empm_deal_t
+    integer :: n = 0      !! particles generated so far, by every process together
+    integer :: every = 1  !! number of processes
+    integer :: rank = 0   !! this process, 0 .. every − 1
+  contains
+    procedure :: next => deal_next
+  end type empm_deal_t
+
 contains
+
+  !> One more particle generated: its id, and whether this process stores it.
+  subroutine deal_next(self, id, mine)
+    class(empm_deal_t), intent(inout) :: self !! the dealing
+    integer, intent(out) :: id                !! the particle's id (1-based generation order)
+    logical, intent(out) :: mine              !! this process stores it
+    self%n = self%n + 1
+    id = self%n
+    mine = mod(id - 1, self%every) == self%rank
+  end subroutine deal_next
 
   !> Append the particles of one body. A box fills each grid cell it meets with ppc points
   !> per direction (Gauss or voxel positions) on the part of the cell inside it, so a face
@@ -25,8 +47,9 @@ contains
   !> that lie inside it. A particle's volume is the filled volume times its quadrature weight
   !> share, and its half-length is half its voxel's size (used by uGIMP).
   !> The particles' state variables start at zero (the model's set-up initialises them).
+  !> With `deal`, only this process's share of them is stored ([[empm_deal_t]]).
   subroutine empm_fill(pts, grid, geom, lo, hi, center, radius, ppc, placement, rho, mat, &
-                       nadded, info, err)
+                       nadded, info, err, deal)
     type(empm_particles_t), intent(inout) :: pts !! particle set (appended to)
     type(empm_grid_t), intent(in) :: grid        !! background grid
     integer, intent(in) :: geom                  !! GEOM_BOX or GEOM_DISK
@@ -37,15 +60,19 @@ contains
     integer, intent(in) :: placement             !! PLACE_GAUSS or PLACE_VOXEL
     real(wp), intent(in) :: rho                  !! density [kg/m³]
     integer, intent(in) :: mat                   !! material index
-    integer, intent(out) :: nadded               !! particles added
+    integer, intent(out) :: nadded               !! particles the body has (with `deal`:
+                                                 !! on every process together)
     integer, intent(out) :: info                 !! 0 ok, 1 bad ppc, 2 bad geometry/placement,
                                                  !! 3 out of memory (with `err`)
     type(empm_error_t), intent(inout), optional :: err !! allocation failure when the storage
                                                        !! grows; without it the program stops
+    type(empm_deal_t), intent(inout), optional :: deal !! dealing out to processes: ids and
+                                                       !! this process's share
     type(empm_error_t) :: e
     real(wp) :: xi(4), wi(4), x(3), lp(3), w, cellvol, a(3), b(3), wd(3)
     integer :: d, nd, c(3), s(3), cmax(3), k, c1, c2, c3
-    logical :: inside, clip(3)
+    logical :: inside, clip(3), mine
+    integer :: id
     nadded = 0; info = 0
     nd = grid%ndim
     if (ppc < 1 .or. ppc > 4) then
@@ -101,16 +128,20 @@ contains
               w = w * wi(s(d))
             end do
             if (geom == GEOM_DISK) inside = sum((x(1:nd) - center(1:nd))**2) <= radius**2
-            if (inside) then
-              if (present(err)) then
-                call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat, e)
-                if (e%code /= 0) then
-                  err = e; info = 3; return
-                end if
-              else
-                call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat)
+            if (.not. inside) cycle
+            nadded = nadded + 1
+            id = pts%np + 1
+            if (present(deal)) then
+              call deal%next(id, mine)
+              if (.not. mine) cycle
+            end if
+            if (present(err)) then
+              call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat, e, id=id)
+              if (e%code /= 0) then
+                err = e; info = 3; return
               end if
-              nadded = nadded + 1
+            else
+              call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat, id=id)
             end if
           end do
         end do

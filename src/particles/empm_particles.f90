@@ -184,7 +184,7 @@ contains
   !> state variables. Grows the storage geometrically when full (set-up only, never in the time
   !> loop). On an allocation failure nothing is appended and the error is reported as in
   !> [[particles_alloc]].
-  subroutine particles_append(self, x, vol, rho, lp, mat, err)
+  subroutine particles_append(self, x, vol, rho, lp, mat, err, id)
     class(empm_particles_t), intent(inout) :: self     !! particle set
     real(wp), intent(in) :: x(:)                       !! position (ndim)
     real(wp), intent(in) :: vol                        !! volume [m³]
@@ -192,6 +192,8 @@ contains
     real(wp), intent(in) :: lp(:)                      !! half-lengths of the particle domain (ndim)
     integer, intent(in) :: mat                         !! material index
     type(empm_error_t), intent(inout), optional :: err !! allocation failure, if present
+    integer, intent(in), optional :: id                !! its number in generation order
+                                                       !! (default: its index in the set)
     type(empm_particles_t) :: tmp
     type(empm_error_t) :: e
     integer :: n, d
@@ -224,6 +226,7 @@ contains
     self%lam_prev(:, n) = 0.0_wp; self%lam_old_prev(:, n) = huge(1.0_wp)
     self%mat(n) = mat
     self%id(n) = n
+    if (present(id)) self%id(n) = id
     self%state(:, n) = 0.0_wp
   end subroutine particles_append
 
@@ -306,34 +309,38 @@ contains
 
   !> Make the set the n particles of `rows` ([[particles_pack_rows]]), in that order; storage
   !> for exactly n. Allocation failures as in [[particles_alloc]].
-  subroutine particles_set_from_rows(self, ndim, nstate, rows, n, err)
+  subroutine particles_set_from_rows(self, ndim, nstate, rows, n, err, order)
     class(empm_particles_t), intent(inout) :: self     !! particles (replaced)
     integer, intent(in) :: ndim                        !! spatial dimension
     integer, intent(in) :: nstate                      !! state variables per particle
     real(wp), intent(in) :: rows(:,:)                  !! packed particles (row_size, >= n)
     integer, intent(in) :: n                           !! number of particles
     type(empm_error_t), intent(inout), optional :: err !! allocation failure, if present
+    integer, intent(in), optional :: order(:)          !! particle k from column order(k)
+                                                       !! (default k): no sorted copy
     type(empm_error_t) :: e
-    integer :: k, d, o
+    integer :: k, d, o, c
     call self%alloc(ndim, n, nstate, e)
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
     d = ndim; o = 10 * d
     do k = 1, n
-      self%x(:, k) = rows(1:d, k); self%x0(:, k) = rows(d + 1:2 * d, k)
-      self%v(:, k) = rows(2 * d + 1:3 * d, k); self%a(:, k) = rows(3 * d + 1:4 * d, k)
-      self%dx(:, k) = rows(4 * d + 1:5 * d, k); self%lp(:, k) = rows(5 * d + 1:6 * d, k)
-      self%lam(:, k) = rows(6 * d + 1:7 * d, k); self%lam_old(:, k) = rows(7 * d + 1:8 * d, k)
-      self%lam_prev(:, k) = rows(8 * d + 1:9 * d, k)
-      self%lam_old_prev(:, k) = rows(9 * d + 1:10 * d, k)
-      self%m(k) = rows(o + 1, k); self%vol(k) = rows(o + 2, k)
-      self%vol0(k) = rows(o + 3, k); self%rho(k) = rows(o + 4, k)
-      self%stress(:, k) = rows(o + 5:o + 10, k); self%strain(:, k) = rows(o + 11:o + 16, k)
-      self%F(:, :, k) = reshape(rows(o + 17:o + 25, k), [3, 3])
-      self%mat(k) = nint(rows(o + 26, k)); self%id(k) = nint(rows(o + 27, k))
-      self%vol_fill(k) = rows(o + 28, k)
-      self%state(:, k) = rows(o + 29:o + 28 + nstate, k)
+      c = k
+      if (present(order)) c = order(k)
+      self%x(:, k) = rows(1:d, c); self%x0(:, k) = rows(d + 1:2 * d, c)
+      self%v(:, k) = rows(2 * d + 1:3 * d, c); self%a(:, k) = rows(3 * d + 1:4 * d, c)
+      self%dx(:, k) = rows(4 * d + 1:5 * d, c); self%lp(:, k) = rows(5 * d + 1:6 * d, c)
+      self%lam(:, k) = rows(6 * d + 1:7 * d, c); self%lam_old(:, k) = rows(7 * d + 1:8 * d, c)
+      self%lam_prev(:, k) = rows(8 * d + 1:9 * d, c)
+      self%lam_old_prev(:, k) = rows(9 * d + 1:10 * d, c)
+      self%m(k) = rows(o + 1, c); self%vol(k) = rows(o + 2, c)
+      self%vol0(k) = rows(o + 3, c); self%rho(k) = rows(o + 4, c)
+      self%stress(:, k) = rows(o + 5:o + 10, c); self%strain(:, k) = rows(o + 11:o + 16, c)
+      self%F(:, :, k) = reshape(rows(o + 17:o + 25, c), [3, 3])
+      self%mat(k) = nint(rows(o + 26, c)); self%id(k) = nint(rows(o + 27, c))
+      self%vol_fill(k) = rows(o + 28, c)
+      self%state(:, k) = rows(o + 29:o + 28 + nstate, c)
     end do
     self%np = n
   end subroutine particles_set_from_rows

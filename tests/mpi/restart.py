@@ -4,7 +4,8 @@ written by `mpirun -n N` holds every particle in id order (and every surface tra
 state), as a serial run's; continued with
 --restart on M processes (M = 1 without mpirun, 2, 3) the results equal the uninterrupted serial
 run's to 1e-12 (same_answers.py's measure), and a serial checkpoint continues on 2 processes
-likewise.
+likewise. A restart on several processes reads only each process's particles' columns of the
+checkpoint (dealt2d: geostatic bodies, a body from a point list, a traction and probes).
 
 Usage: restart.py EMPM MPIRUN WORKDIR
 """
@@ -14,7 +15,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from same_answers import case_text, compare  # noqa: E402
+from same_answers import case_text, compare, DEALT_POINTS  # noqa: E402
 
 TOL = 1.0e-12
 
@@ -24,6 +25,7 @@ def main():
     work.mkdir(parents=True, exist_ok=True)
     mpi = [mpirun, "--oversubscribe"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
     fails = []
+    (work / "dealt2d_points.csv").write_text(DEALT_POINTS)
 
     def run(n, args):
         cmd = [empm, "run"] + args
@@ -34,7 +36,7 @@ def main():
 
     for name, scheme, shape in [("disks2d", "pc_newmark", "lme"), ("disks2d", "musl", "linear"),
                                 ("block3d", "gen_alpha", "bspline2"),
-                                ("strip2d", "pc_newmark", "lme")]:
+                                ("strip2d", "pc_newmark", "lme"), ("dealt2d", "musl", "ugimp")]:
         tag = f"{name}_{scheme}_{shape}"
         ref = work / f"{tag}.nml"
         ref.write_text(case_text(name, scheme, shape))

@@ -7,7 +7,10 @@
 3. a case file error is reported once, with exit status 2 on every process; so is a particle
    whose support does not fit the grid, found by the process holding it once the particles
    are shared (several processes hold such particles; the serial run's, the smallest id, is
-   named), before the output is claimed (an unusable output folder changes nothing);
+   named), before the output is claimed (an unusable output folder changes nothing); so are
+   the set-up's checks over particles each process stores a share of (a traction box deeper
+   than the outer layer or selecting none, particles on a mirror's ghost side): the serial
+   run's message, naming the particle of smallest id;
 4. case 1 with a surface traction and checkpoints (its loaded particles shared out, the
    checkpoints gathered) stops the same way, with the serial run's message and last good state;
 5. a file the case needs that is missing on one process only (its own working folder, with
@@ -90,6 +93,18 @@ CKPT = LEAVE.replace("snapshot_times = 0.05", "snapshot_times = 0.05, checkpoint
 /
 """
 
+# Set-up checks over the particles that each process stores a share of (docs/parallel.md,
+# "Set-up"): the first offending particle (lowest id, on whichever process) is named as in the
+# serial run (particles 122 and 17: not the first process's on 3 processes, 122 not on 2). A traction
+# box reaching two rows into a body; one selecting no particle; a mirror plane with particles
+# on its ghost side.
+DEEP = CKPT.replace("lo = 0.2, 0.76, hi = 0.8, 0.8", "lo = 0.25, 0.7, hi = 0.8, 0.8")
+NOBOX = CKPT.replace("lo = 0.2, 0.76, hi = 0.8, 0.8", "lo = 0.2, 0.85, hi = 0.8, 0.9")
+GHOST = LEAVE + """&boundary
+  lo = 0.6, 0.0, hi = 0.6, 1.0, fix = .true., .false., mirror = '+x'
+/
+"""
+
 
 def run(cmd, cwd):
     try:
@@ -113,7 +128,8 @@ def main():
     mpi = [mpirun, "--oversubscribe"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
     fails = []
     for name, text, status in [("leave", LEAVE, 3), ("invert", INVERT, 3), ("bad", BAD, 2),
-                               ("unfit", UNFIT, 2), ("ckpt", CKPT, 3)]:
+                               ("unfit", UNFIT, 2), ("ckpt", CKPT, 3), ("deep", DEEP, 2),
+                               ("nobox", NOBOX, 2), ("ghost", GHOST, 2)]:
         nml = work / f"{name}.nml"
         nml.write_text(text)
         rc, slog = run([empm, "run", str(nml), "-o", f"{name}_s.h5"], work)
