@@ -108,12 +108,13 @@ def main():
             cmd = mpi + ["-n", str(r)] + cmd
         proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True,
                                 env=env)
-        # The log is read as it comes: the first progress line ends the set-up.
+        # The log is read as it comes: the first progress line ends the set-up (it comes a few
+        # steps in: a tenth of the run, which the set-up's figure may then include).
         lines, first_step = [], []
 
         def reader():
             for line in proc.stdout:
-                if not first_step and re.search(r"\bstep 1\b", line):
+                if not first_step and re.search(r"%\s+t =.*\bstep \d+", line):
                     first_step.append(time.time())
                 lines.append(line)
         th = threading.Thread(target=reader)

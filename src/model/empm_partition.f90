@@ -6,6 +6,7 @@ module empm_partition
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, empm_raise_error
   use empm_model, only: empm_model_t
+  use empm_particles, only: PARTICLE_FIELDS
   use empm_loads, only: empm_traction_t
   use empm_history, only: empm_history_t, empm_snapshot_t
   use empm_decomp, only: empm_rcb, empm_cell_of, empm_box_owner
@@ -189,42 +190,28 @@ contains
 
   ! Every particle to process dest(p), each process's then in id order, as the set was made
   ! (runs of one material stay together), with the storage of their basis; the empty-node
-  ! threshold kept; tractions follow their particles by id. Collective.
+  ! threshold kept; tractions follow their particles by id. Field by field (the id first), each
+  ! field's storage released once taken: a process holds one field twice at most. Collective.
   subroutine move_particles(model, dest, e)
     type(empm_model_t), intent(inout) :: model
     integer, intent(in) :: dest(:)
     type(empm_error_t), intent(inout) :: e
-    real(wp), allocatable :: rows(:,:), got(:,:)
-    integer, allocatable :: order(:), first(:), perm(:)
-    integer :: p, np, m, n, nd, ns
+    real(wp), allocatable :: cols(:,:), got(:,:)
+    integer, allocatable :: order(:)
+    integer :: f, np
     real(wp) :: mass_tol
-    np = model%pts%np; nd = model%grid%ndim; ns = model%pts%nstate
-    m = model%pts%row_size()
-    ! Packed grouped by destination (each group in this process's order), so that the exchange
-    ! sends the rows as they are; at most two copies of a process's particles at a time: the
-    ! storage goes once packed.
-    allocate(rows(m, np), first(0:model%comm%nranks), perm(np))
-    first = 0
-    do p = 1, np
-      first(dest(p)) = first(dest(p)) + 1
+    np = model%pts%np
+    do f = 1, PARTICLE_FIELDS
+      call model%pts%take_field(f, cols)
+      call model%comm%exchange_rows(cols, np, dest, got)
+      deallocate(cols)
+      if (f == 1) order = id_order(nint(got(1, :)))
+      call model%pts%put_field(f, got, order)
+      deallocate(got)
     end do
-    first = eoshift(first, -1)
-    do p = 1, model%comm%nranks
-      first(p) = first(p) + first(p - 1)
-    end do
-    do p = 1, np
-      first(dest(p)) = first(dest(p)) + 1
-      perm(first(dest(p))) = p
-    end do
-    call model%pts%pack_rows(perm, rows)
-    call model%pts%alloc(nd, 0, ns)
-    call model%comm%exchange_rows(rows, np, dest(perm), got)
-    deallocate(rows)
-    n = size(got, 2)
-    order = id_order(nint(got(model%pts%id_row(), 1:n)))
+    model%pts%np = size(order)
     mass_tol = model%nodes%mass_tol
-    call model%pts%set_from_rows(nd, ns, got, n, e, order=order)
-    if (e%code == 0) call model%set_runs(e)
+    call model%set_runs(e)
     if (e%code /= 0) return
     model%nodes%mass_tol = mass_tol
     call empm_share_traction_state(model)
@@ -412,7 +399,7 @@ contains
     real(wp), allocatable :: rows(:,:), all(:,:)
     integer, allocatable :: dest(:), order(:)
     type(empm_error_t) :: e
-    integer :: m, np, k, nd, ns, oid, first, last, ntotal
+    integer :: m, np, k, nd, ns, oid, first, last, ntotal, f
     logical :: by_block
     if (.not. model%comm%parallel()) return
     by_block = .false.
@@ -429,21 +416,37 @@ contains
     do k = 1, hist%nsnap
       call gather_snapshot(hist%snap(k))
     end do
+    if (by_block) then
+      ! Field by field (the id first), each field's storage released once taken: a process
+      ! holds one field twice at most, not its whole set.
+      dest = [(owner(model%pts%id(k)), k = 1, np)]
+      do f = 1, PARTICLE_FIELDS
+        call model%pts%take_field(f, rows)
+        call model%comm%exchange_rows(rows, np, dest, all)
+        deallocate(rows)
+        if (f == 1) then
+          ! Particle k of the block is id first + k − 1.
+          allocate(order(last - first + 1))
+          do k = 1, size(all, 2)
+            order(nint(all(1, k)) - first + 1) = k
+          end do
+        end if
+        call model%pts%put_field(f, all, order)
+        deallocate(all)
+      end do
+      model%pts%np = size(order)
+      ! A block is written and dropped: it needs no material runs nor basis storage.
+      return
+    end if
     m = model%pts%row_size()
     allocate(rows(m, np))
     call model%pts%pack_rows([(k, k = 1, np)], rows)
     oid = model%pts%id_row()
-    ! At most two copies of the particles at a time: the storage goes once packed (on a
-    ! process other than the root, gathering to it, the model keeps its particles).
-    if (by_block) then
-      dest = [(owner(nint(rows(oid, k))), k = 1, np)]
-      call model%pts%alloc(nd, 0, ns)
-      call model%comm%exchange_rows(rows, np, dest, all)
-    else
-      call model%comm%gather_rows(rows, np, all)
-      if (.not. model%comm%is_root()) return
-      call model%pts%alloc(nd, 0, ns)
-    end if
+    ! On a process other than the root, gathering to it, the model keeps its particles.
+    call model%comm%gather_rows(rows, np, all)
+    if (.not. model%comm%is_root()) return
+    ! At most two copies of the particles at a time: the storage goes once sent.
+    call model%pts%alloc(nd, 0, ns)
     deallocate(rows)
     ! Particle k of the result is id first + k − 1.
     allocate(order(last - first + 1))
@@ -454,9 +457,7 @@ contains
     if (e%code /= 0) then
       call empm_raise_error(e, err); return
     end if
-    ! The root's model stays a whole one (material runs, basis storage); a block is written
-    ! and dropped, so it needs none.
-    if (by_block) return
+    ! The root's model stays a whole one (material runs, basis storage).
     call model%set_runs(e)
     if (e%code /= 0) call empm_raise_error(e, err)
 

@@ -13,7 +13,11 @@ module empm_particles
   use empm_screen, only: empm_screen_finite, empm_screen_finite2
   implicit none
   private
-  public :: empm_particles_t
+  public :: empm_particles_t, PARTICLE_FIELDS
+
+  !> Number of arrays a particle set stores per particle ([[particles_take_field]]); the id
+  !> is field 1.
+  integer, parameter :: PARTICLE_FIELDS = 21
 
   !> Particle state (structure of arrays).
   type :: empm_particles_t
@@ -65,6 +69,8 @@ module empm_particles
     procedure :: pack_rows => particles_pack_rows
     procedure :: set_from_rows => particles_set_from_rows
     procedure :: keep => particles_keep
+    procedure :: take_field => particles_take_field
+    procedure :: put_field => particles_put_field
   end type empm_particles_t
 
 contains
@@ -344,6 +350,85 @@ contains
     end do
     self%np = n
   end subroutine particles_set_from_rows
+
+  !> Field f (1..PARTICLE_FIELDS; 1 is the id) of particles 1..np as columns, one per
+  !> particle (integers as reals), and the field's storage released: a set moved field by
+  !> field to other processes holds one field twice at most, not the whole set
+  !> ([[particles_put_field]]).
+  subroutine particles_take_field(self, f, cols)
+    class(empm_particles_t), intent(inout) :: self     !! particles (field f released)
+    integer, intent(in) :: f                           !! field, 1..PARTICLE_FIELDS
+    real(wp), allocatable, intent(out) :: cols(:,:)    !! its values (width, np)
+    integer :: n
+    n = self%np
+    select case (f)
+    case (1); cols = reshape(real(self%id(1:n), wp), [1, n]); deallocate(self%id)
+    case (2); call take2(self%x)
+    case (3); call take2(self%x0)
+    case (4); call take2(self%v)
+    case (5); call take2(self%a)
+    case (6); call take2(self%dx)
+    case (7); call take1(self%m)
+    case (8); call take1(self%vol)
+    case (9); call take1(self%vol0)
+    case (10); call take1(self%rho)
+    case (11); call take2(self%stress)
+    case (12); call take2(self%strain)
+    case (13); cols = reshape(self%F(:, :, 1:n), [9, n]); deallocate(self%F)
+    case (14); call take2(self%lp)
+    case (15); call take2(self%lam)
+    case (16); call take2(self%lam_old)
+    case (17); call take2(self%lam_prev)
+    case (18); call take2(self%lam_old_prev)
+    case (19); call take1(self%vol_fill)
+    case (20); cols = reshape(real(self%mat(1:n), wp), [1, n]); deallocate(self%mat)
+    case (21); call take2(self%state)
+    end select
+  contains
+    subroutine take1(a)
+      real(wp), allocatable, intent(inout) :: a(:)
+      cols = reshape(a(1:n), [1, n]); deallocate(a)
+    end subroutine take1
+    subroutine take2(a)
+      real(wp), allocatable, intent(inout) :: a(:,:)
+      cols = a(:, 1:n); deallocate(a)
+    end subroutine take2
+  end subroutine particles_take_field
+
+  !> Field f of a set of n particles from columns (those of [[particles_take_field]], in the
+  !> new set's order: particle k from column order(k)). The caller sets `np` = n once every
+  !> field is put (each field is taken with the old `np`).
+  subroutine particles_put_field(self, f, cols, order)
+    class(empm_particles_t), intent(inout) :: self     !! particles (field f replaced)
+    integer, intent(in) :: f                           !! field, 1..PARTICLE_FIELDS
+    real(wp), intent(in) :: cols(:,:)                  !! values (width, >= maxval(order))
+    integer, intent(in) :: order(:)                    !! column of each particle
+    integer :: n
+    n = size(order)
+    select case (f)
+    case (1); self%id = nint(cols(1, order))
+    case (2); self%x = cols(:, order)
+    case (3); self%x0 = cols(:, order)
+    case (4); self%v = cols(:, order)
+    case (5); self%a = cols(:, order)
+    case (6); self%dx = cols(:, order)
+    case (7); self%m = cols(1, order)
+    case (8); self%vol = cols(1, order)
+    case (9); self%vol0 = cols(1, order)
+    case (10); self%rho = cols(1, order)
+    case (11); self%stress = cols(:, order)
+    case (12); self%strain = cols(:, order)
+    case (13); self%F = reshape(cols(:, order), [3, 3, n])
+    case (14); self%lp = cols(:, order)
+    case (15); self%lam = cols(:, order)
+    case (16); self%lam_old = cols(:, order)
+    case (17); self%lam_prev = cols(:, order)
+    case (18); self%lam_old_prev = cols(:, order)
+    case (19); self%vol_fill = cols(1, order)
+    case (20); self%mat = nint(cols(1, order))
+    case (21); self%state = cols(:, order)
+    end select
+  end subroutine particles_put_field
 
   !> Keep particles idx(1), idx(2), ... (increasing), in that order, as particles 1, 2, ...;
   !> the others are dropped (the storage keeps its size).
