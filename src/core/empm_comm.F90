@@ -13,7 +13,7 @@ module empm_comm
     MPI_Allreduce, MPI_IN_PLACE, MPI_DOUBLE_PRECISION, MPI_INTEGER, MPI_LOGICAL, MPI_SUM, &
     MPI_Op, MPI_MAX, MPI_MIN, MPI_LOR, MPI_Bcast, MPI_Alltoall, MPI_Alltoallv, MPI_CHARACTER, &
     MPI_Gather, MPI_Gatherv, MPI_Barrier, MPI_Allgather, MPI_Allgatherv, MPI_Request, &
-    MPI_Isend, MPI_Irecv, &
+    MPI_Isend, MPI_Irecv, MPI_Comm_split_type, MPI_COMM_TYPE_SHARED, MPI_INFO_NULL, &
     MPI_Waitall, MPI_STATUSES_IGNORE, MPI_Abort, operator(/=)
 #endif
   implicit none
@@ -53,6 +53,7 @@ module empm_comm
     procedure :: any_true => comm_any_true
     procedure :: bcast_text => comm_bcast_text
     procedure :: agree => comm_agree
+    procedure :: machine_size => comm_machine_size
     procedure :: gather_rows => comm_gather_rows
     procedure :: exchange_rows => comm_exchange_rows
     procedure :: allgather_ints => comm_allgather_ints
@@ -348,6 +349,22 @@ contains
     if (n > 0) call MPI_Bcast(text, n, MPI_CHARACTER, from, self%handle)
 #endif
   end subroutine comm_bcast_text
+
+  !> The number of processes of this communicator that share this process's machine (its
+  !> memory): MPI's shared-memory split. Collective; 1 without MPI.
+  integer function comm_machine_size(self) result(k)
+    class(empm_comm_t), intent(in) :: self     !! communicator
+#ifdef EMPM_USE_MPI
+    type(MPI_Comm) :: local
+#endif
+    k = 1
+    if (self%nranks <= 1) return
+#ifdef EMPM_USE_MPI
+    call MPI_Comm_split_type(self%handle, MPI_COMM_TYPE_SHARED, self%rank, MPI_INFO_NULL, local)
+    call MPI_Comm_size(local, k)
+    call MPI_Comm_free(local)
+#endif
+  end function comm_machine_size
 
   !> Every process takes the error of the first process that has one (or none): so that all
   !> stop together, where one alone (a file missing on its machine) would leave the others

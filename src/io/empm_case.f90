@@ -39,6 +39,7 @@ module empm_case
     !> shared by place among processes (each stores its share only: body_first..body_last
     !> below are then its own particles of each body).
     type(empm_deal_t) :: deal
+    integer :: local = 1                             !! processes of the run on this machine
     ! Bodies (&particles groups, in order): their particles are body_first..body_last.
     character(len=64), allocatable :: body_name(:)   !! body labels ('' when unnamed)
     integer, allocatable :: body_first(:)            !! first particle of each body

@@ -231,11 +231,9 @@ contains
         write(error_unit, '(a)') 'empm: note: '//warning
     end if
     if (cs%model%comm%parallel()) then
-      if (resumed) then
-        call empm_partition_particles(cs%model, e, dealt=.true.)
-        if (e%code == EMPM_OK) call empm_check_basis(path, cs, e)
-        call empm_agree_error(cs%model%comm, e)
-      end if
+      ! No basis is evaluated here: a restart continues from the checkpoint's shape-function
+      ! state (the LME multipliers the next evaluation starts from), as a serial one does.
+      if (resumed) call empm_partition_particles(cs%model, e, dealt=.true.)
       if (e%code /= EMPM_OK) then
         call release(); call empm_raise_error(e, err); return
       end if

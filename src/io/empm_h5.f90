@@ -350,7 +350,7 @@ contains
     real(wp), intent(inout), optional :: r1(:), r2(:,:)
     integer(hsize_t) :: start(size(dims)), stride(size(dims))
     integer(hid_t) :: did, fsid, msid
-    integer :: e(7), r
+    integer :: e(8), r
     e = 0; r = size(dims)
     call h5dopen_f(loc, name, did, e(1))
     if (e(1) /= 0) then
@@ -359,7 +359,7 @@ contains
     fsid = H5S_ALL_F; msid = H5S_ALL_F
     if (present(cols)) then
       if (product(dims) == 0) then
-        call h5dclose_f(did, e(2)); return
+        call h5dclose_f(did, e(8)); return
       end if
       call h5dget_space_f(did, fsid, e(2))
       start = 0; start(r) = cols(1)
@@ -372,7 +372,7 @@ contains
     if (present(cols)) then
       call h5sclose_f(fsid, e(6)); call h5sclose_f(msid, e(7))
     end if
-    call h5dclose_f(did, e(2))
+    call h5dclose_f(did, e(8))
     if (any(e /= 0)) ierr = 1
   end subroutine read_any
 

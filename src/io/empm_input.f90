@@ -293,6 +293,7 @@ contains
       if (shared .and. comm%parallel()) then
         cs%model%comm = comm
         cs%deal = empm_deal_t(every=comm%nranks, rank=comm%rank)
+        cs%local = comm%machine_size()
       end if
     end if
     call empm_read_text(path, cs%text, e)
@@ -311,6 +312,7 @@ contains
     if (e%code == EMPM_OK) call read_shape(gs, cs, ov, reg, e)
     if (e%code == EMPM_OK) call read_particles(path, gs, cs, ov, e)
     call cs%model%comm%agree(e)
+    if (e%code == EMPM_OK) call same_particles(path, cs, e)
     if (e%code == EMPM_OK) call read_integrator(path, gs, cs, ov, reg, e)
     if (e%code == EMPM_OK) call read_loads(gs, cs, e)
     if (e%code == EMPM_OK) call apply_geostatic(gs, cs, e)
@@ -329,6 +331,21 @@ contains
   end subroutine empm_read_case
 
   ! ---- helpers ----------------------------------------------------------------------------
+
+  !> Dealt out among processes (cs%deal), every process must have generated the same number of
+  !> particles: a body file that differs between machines would otherwise give ids twice or
+  !> not at all. Collective.
+  subroutine same_particles(path, cs, e)
+    character(len=*), intent(in) :: path
+    type(empm_case_t), intent(in) :: cs
+    type(empm_error_t), intent(inout) :: e
+    integer :: lo, hi
+    if (cs%deal%every <= 1) return
+    lo = cs%model%comm%min_int(cs%deal%n); hi = cs%model%comm%max_int(cs%deal%n)
+    if (lo /= hi) call e%set(EMPM_ERR_INPUT, 'the processes generated different numbers of '// &
+      'particles ('//str(lo)//' to '//str(hi)//'): do the bodies'' files differ between '// &
+      'the machines?', file=path)
+  end subroutine same_particles
 
   !> Every group must be known (or one of `extra`), and a group that may appear once must not
   !> appear twice.
@@ -643,7 +660,8 @@ contains
       if (e%code /= EMPM_OK) return
       p0 = cs%model%pts%np
       call empm_fill(cs%model%pts, cs%model%grid, geom, lo, hi, center, radius, ppc, place, &
-        cs%model%mats(imat)%model%rho0, imat, nadded, info, deal=cs%deal)
+        cs%model%mats(imat)%model%rho0, imat, nadded, info, err=e, deal=cs%deal)
+      if (info == 3) return ! out of memory, in e
       if (nadded == 0) then
         call g%fail(e, '', 'body '//str(nbody)//': the geometry contains no particle '// &
           'position of the grid: check lo/hi or center/radius against &grid'); return
@@ -759,7 +777,7 @@ contains
   ! state variables; the material index), the solver's copy of the last good state (as much
   ! again), the shape-function basis (max_nodes node indices, values and ndim gradients) and
   ! scratch; refused (key ppc) when above the machine's physical memory (for a case shared by
-  ! place among processes, one process's share of the particles with the whole grid).
+  ! place among processes, the shares of the processes on this machine, each with the grid).
   subroutine check_particle_memory(g, cs, np, e)
     type(empm_group_t), intent(in) :: g
     type(empm_case_t), intent(in) :: cs
@@ -777,11 +795,12 @@ contains
     per = 2_int64 * (8_int64 * (7_int64 * nd + 25_int64 + nstate) + 4_int64) + &
       maxn * (4_int64 + 8_int64 + 8_int64 * nd) + 4_int64 + 8_int64 * (2_int64 * nd + 1_int64)
     nnode = product(int(cs%model%grid%ncell(1:nd), int64) + 1_int64)
-    ! Shared by place among processes, each stores its share (cs%deal).
+    ! Shared by place among processes, each stores its share (cs%deal), and the processes on
+    ! this machine share its memory.
     share = ''
     if (cs%deal%every > 1) share = ' (each of the '//str(cs%deal%every)//' processes about '// &
-      i64(np / cs%deal%every)//')'
-    bytes = (np / cs%deal%every) * per + nnode * (8_int64 + 52_int64 * nd)
+      i64(np / cs%deal%every)//', '//str(cs%local)//' of them on this machine)'
+    bytes = cs%local * ((np / cs%deal%every) * per + nnode * (8_int64 + 52_int64 * nd))
     mem = empm_physical_memory()
     if (np > int(huge(1), int64)) then
       call g%fail(e, 'ppc', 'the bodies would have about '//i64(np)// &
@@ -790,7 +809,7 @@ contains
       call g%fail(e, 'ppc', 'the bodies would have about '//i64(np)// &
         ' particles'//share//', which with the grid need about '// &
         str_short(real(bytes, wp) / 2.0_wp**30)// &
-        ' GiB'//trim(merge(' each', '     ', cs%deal%every > 1))//' ('//i64(bytes)// &
+        ' GiB'//trim(merge(' here', '     ', cs%deal%every > 1))//' ('//i64(bytes)// &
         ' bytes), more than this machine''s '// &
         str_short(real(mem, wp) / 2.0_wp**30)//' GiB ('//i64(mem)//' bytes)')
     end if

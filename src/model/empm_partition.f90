@@ -212,6 +212,9 @@ contains
     model%pts%np = size(order)
     mass_tol = model%nodes%mass_tol
     call model%set_runs(e)
+    ! A failure (out of memory) on one process is everyone's: the callers' next steps are
+    ! collective.
+    call model%comm%agree(e)
     if (e%code /= 0) return
     model%nodes%mass_tol = mass_tol
     call empm_share_traction_state(model)

@@ -138,7 +138,7 @@ contains
             if (present(err)) then
               call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat, e, id=id)
               if (e%code /= 0) then
-                err = e; info = 3; return
+                err = e; info = 3; nadded = nadded - 1; return
               end if
             else
               call pts%append(x(1:nd), w * cellvol, rho, lp(1:nd), mat, id=id)

@@ -14,7 +14,8 @@
 4. case 1 with a surface traction and checkpoints (its loaded particles shared out, the
    checkpoints gathered) stops the same way, with the serial run's message and last good state;
 5. a file the case needs that is missing on one process only (its own working folder, with
-   mpirun's MPMD form) gives status 2 and one message naming the file, on every process;
+   mpirun's MPMD form) gives status 2 and one message naming the file, on every process; so
+   does a point list that differs between the processes' folders;
 6. an output that one process cannot write (its file size limited) gives status 4 and one
    message naming the file, and leaves no partial file.
 No process may hang: each run has a time limit.
@@ -188,6 +189,24 @@ def main():
         fails.append(f"missing file on process 1: exit {rc}, messages {errs}: {log[-400:]}")
     else:
         print(f"ok   missing file on process 1 of 2: exit {rc}: {errs[0][:110]}")
+    # 5b. A point list that differs between the processes' folders (one point more for
+    # process 1): every process generates the particles, so they would disagree on the ids;
+    # status 2 and one message on every process.
+    body = "x, y, volume\n" + "".join(f"{0.25 + 0.1 * i:.2f}, 0.35, 0.01\n" for i in range(5))
+    for sub, extra in (("D", ""), ("E", "0.85, 0.45, 0.01\n")):
+        (work / sub).mkdir(exist_ok=True)
+        (work / sub / "pts.csv").write_text(body + extra)
+        (work / sub / "pts.nml").write_text(LEAVE.replace(
+            "geometry = 'box', lo = 0.2, 0.2, hi = 0.8, 0.8, ppc = 2",
+            "geometry = 'file', file = 'pts.csv'"))
+    rc, log = run(mpi + ["-n", "1", "--wdir", str(work / "D"), empm, "run", "pts.nml", ":",
+                         "-n", "1", "--wdir", str(work / "E"), empm, "run", "pts.nml"], work)
+    errs = error_lines(log)
+    if rc != 2 or len(errs) != 1 or "different numbers of particles" not in errs[0]:
+        fails.append(f"body files differing between processes: exit {rc}, messages {errs}: "
+                     f"{log[-400:]}")
+    else:
+        print(f"ok   body files differing between processes: exit {rc}: {errs[0][:110]}")
     # 6. The output cannot be written by one process (its file size limited, as by a full
     # disk or a quota): status 4 on every process, one message naming the file and the reason,
     # no partial file left, no hang. Written together (parallel HDF5) the job ends there
