@@ -34,13 +34,12 @@ module empm_bench
   use empm_timer, only: PHASE_COUNT, PHASE_NAMES
   use empm_parallel, only: empm_set_threads, empm_max_threads
   use empm_strings, only: str, lower
-  use empm_files, only: empm_proc_kib
+  use empm_files, only: empm_proc_kib, empm_peak_memory
   use empm_case, only: empm_case_t
   use empm_input, only: empm_read_case
   implicit none
   private
-  public :: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json, &
-            empm_peak_rss_bytes
+  public :: empm_bench_config_t, empm_bench_result_t, empm_bench_run, empm_bench_json
 
   real(wp), parameter :: BENCH_E = 1.0e7_wp     !! Young's modulus [Pa]
   real(wp), parameter :: BENCH_NU = 0.3_wp      !! Poisson's ratio
@@ -134,7 +133,7 @@ contains
                       err); return
     end if
     call empm_set_threads(cfg%threads)
-    rss0 = empm_peak_rss_bytes()
+    rss0 = empm_peak_memory()
 
     ! The family first (on a provisional grid: only the dimension matters), for its padding.
     h = 1.0_wp / cfg%cells
@@ -263,7 +262,7 @@ contains
       if (allocated(state0)) nchanged = nchanged + &
         count(any(state0 /= model%pts%state(:, 1:model%pts%np), dim=1))
     end do
-    rss1 = empm_peak_rss_bytes()
+    rss1 = empm_peak_memory()
 
     res%dim = model%grid%ndim
     res%shape = model%shape%name()
@@ -317,7 +316,7 @@ contains
     integer(int64) :: rss0
     real(wp) :: dt
     call empm_set_threads(cfg%threads)
-    rss0 = empm_peak_rss_bytes()
+    rss0 = empm_peak_memory()
     call empm_read_case(trim(cfg%case_file), cs, e)
     if (e%code == 0) call cs%integ%prepare(cs%model, e)
     if (e%code /= 0) then
@@ -420,14 +419,6 @@ contains
       if (lower(trim(adjustl(item(1:eq - 1)))) == lower(key)) has_key = .true.
     end do
   end function has_key
-
-  !> Peak resident set size of this process (VmHWM of /proc/self/status) [bytes]; −1 when
-  !> unavailable (not Linux).
-  function empm_peak_rss_bytes() result(bytes)
-    integer(int64) :: bytes !! peak RSS [bytes], or −1
-    bytes = empm_proc_kib('/proc/self/status', 'VmHWM:')
-    if (bytes > 0) bytes = 1024_int64 * bytes
-  end function empm_peak_rss_bytes
 
   !> One-line JSON object with the keys of docs/performance.md.
   function empm_bench_json(res) result(s)

@@ -7,7 +7,7 @@ module empm_files
   implicit none
   private
   public :: empm_rename, empm_remove, empm_mkdir_p, empm_read_text, empm_physical_memory, &
-            empm_proc_kib
+            empm_proc_kib, empm_peak_memory
 
   interface
     function c_rename(old, new) bind(C, name='rename') result(r)
@@ -91,6 +91,14 @@ contains
     bytes = empm_proc_kib('/proc/meminfo', 'MemTotal:')
     if (bytes > 0) bytes = 1024_int64 * bytes
   end function empm_physical_memory
+
+  !> Peak resident memory of this process so far (VmHWM of /proc/self/status) [bytes]; −1
+  !> when unavailable (not Linux).
+  function empm_peak_memory() result(bytes)
+    integer(int64) :: bytes !! peak resident memory [bytes], or −1
+    bytes = empm_proc_kib('/proc/self/status', 'VmHWM:')
+    if (bytes > 0) bytes = 1024_int64 * bytes
+  end function empm_peak_memory
 
   !> The number after `key` on its line of a /proc file in kB (e.g. 'VmHWM:' of
   !> /proc/self/status), or -1 when the file or the key is missing.

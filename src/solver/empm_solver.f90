@@ -16,6 +16,7 @@ module empm_solver
   use empm_shape, only: shape_status_text, SHAPE_OUTSIDE_GRID
   use empm_terminal, only: stderr_is_terminal
   use empm_screen, only: empm_screen_finite2, empm_screen_finite3
+  use empm_files, only: empm_peak_memory
   implicit none
   private
   public :: empm_run_params
@@ -107,6 +108,8 @@ module empm_solver
     integer :: stored_nodes = 0         !! most grid nodes a process stored at once (its
                                         !! window; parallel runs)
     integer :: windows = 0              !! new windows taken, all processes together
+    real(wp) :: peak_memory = -1.0_wp   !! largest peak resident memory of a process so far
+                                        !! (set-up and time loop) [bytes]; < 0: unknown
   end type empm_run_stats_t
 
 contains
@@ -552,6 +555,7 @@ contains
       st%grid_nodes = product(model%grid%nn)
       st%stored_nodes = nint(model%comm%max_real(real(model%stored_peak, wp)))
       st%windows = model%comm%sum_int(model%windows)
+      st%peak_memory = model%comm%max_real(real(empm_peak_memory(), wp))
       if (present(stats)) stats = st
     end subroutine finish_stats
 
@@ -971,6 +975,11 @@ contains
       s = s//', '//str(st%migrated)//' particles migrated, halo '//trim(adjustl(e0))// &
         ' bytes per step, grid nodes stored per process at most '//str(st%stored_nodes)// &
         ' of '//str(st%grid_nodes)//' ('//str(st%windows)//' windows)'
+    end if
+    if (st%peak_memory > 0.0_wp) then
+      write(e0, '(f12.1)') st%peak_memory / 2.0_wp**20
+      s = s//'; peak memory '//trim(adjustl(e0))//' MiB'
+      if (st%nranks > 1) s = s//' per process at most'
     end if
   end function empm_run_summary
 
