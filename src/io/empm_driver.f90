@@ -22,7 +22,7 @@ module empm_driver
   use empm_h5_mpio, only: empm_h5_collective
   implicit none
   private
-  public :: empm_run_case, empm_agree_error, empm_write_shared
+  public :: empm_run_case, empm_write_shared
 
   ! Checkpoints next to the results file, and the stop signal the program caught (if it
   ! installed the handlers: `empm run` does, the library does not).
@@ -58,11 +58,11 @@ contains
     call empm_copy_for_output(model, whole)
     hwhole = hist
     call empm_gather_particles(whole, hwhole, err, blocks=together)
-    if (together) call empm_agree_error(model%comm, err)
+    if (together) call model%comm%agree(err)
     if (err%code == EMPM_OK .and. (together .or. model%comm%is_root())) &
       call empm_checkpoint_write(self%path, self%prev, whole, hwhole, state, self%case_text, err, &
       together)
-    call empm_agree_error(model%comm, err)
+    call model%comm%agree(err)
   end subroutine hook_checkpoint
 
   !> Write the results of a run shared among the processes of `model%comm` (or of a serial
@@ -82,10 +82,10 @@ contains
     logical :: together
     together = empm_h5_collective(model%comm)
     call empm_gather_particles(model, hist, err, blocks=together)
-    if (together) call empm_agree_error(model%comm, err)
+    if (together) call model%comm%agree(err)
     if (err%code == EMPM_OK .and. (together .or. model%comm%is_root())) &
       call empm_write_results(path, model, hist, meta, complete, status, err, together)
-    call empm_agree_error(model%comm, err)
+    call model%comm%agree(err)
   end subroutine empm_write_shared
 
   integer function hook_stop(self) result(sig)
@@ -93,14 +93,6 @@ contains
     associate (unused_ => self); end associate
     sig = empm_stop_signal()
   end function hook_stop
-
-  !> Every process of `comm` takes the error of the first process that has one (or none).
-  !> Collective ([[empm_comm_t]]'s `agree`).
-  subroutine empm_agree_error(comm, e)
-    type(empm_comm_t), intent(in) :: comm      !! the processes
-    type(empm_error_t), intent(inout) :: e     !! this process's outcome in, the first one out
-    call comm%agree(e)
-  end subroutine empm_agree_error
 
   !> Run the case in `path`, writing HDF5 to `output` (default: the case's &output file).
   !> Exit-status semantics when `err` is absent: 2 invalid input, 3 run-time guard, 4 I/O.
@@ -163,14 +155,10 @@ contains
     shared = .false.
     if (present(comm)) shared = comm%parallel()
     ! Shared, each process stores its share of the particles only (collective).
-    if (shared) then
-      call empm_read_case(path, cs, e, extra_groups=extra_groups, shared=shared, comm=comm)
-    else
-      call empm_read_case(path, cs, e, extra_groups=extra_groups, shared=shared)
-    end if
+    call empm_read_case(path, cs, e, extra_groups=extra_groups, shared=shared, comm=comm)
     ! Each process reads the case: one that cannot (a file missing on its machine) must not
     ! leave the others waiting. All take the error of the first process that has one.
-    if (present(comm)) call empm_agree_error(comm, e)
+    if (present(comm)) call comm%agree(e)
     if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
     end if
@@ -194,14 +182,14 @@ contains
       ! the output is claimed (an unfit case is the same input error, exit 2).
       call empm_partition_particles(cs%model, e, dealt=.true.)
       if (e%code == EMPM_OK) call empm_check_basis(path, cs, e)
-      call empm_agree_error(cs%model%comm, e)
+      call cs%model%comm%agree(e)
       if (e%code /= EMPM_OK) then
         call empm_raise_error(e, err); return
       end if
     end if
     ! The root claims the output for all (one file, one lock); its verdict is everyone's.
     if (cs%model%comm%is_root()) call empm_output_claim(cs%output_file, e)
-    call empm_agree_error(cs%model%comm, e)
+    call cs%model%comm%agree(e)
     if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
     end if
@@ -222,7 +210,7 @@ contains
       ! the processes of their boxes below.
       call empm_checkpoint_read(trim(restart), cs%model, hist, sst, cs%text, warning, e, &
                                 dealt=cs%deal)
-      call empm_agree_error(cs%model%comm, e)
+      call cs%model%comm%agree(e)
       if (e%code /= EMPM_OK) then
         call release()
         call empm_raise_error(e, err); return
