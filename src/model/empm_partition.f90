@@ -4,7 +4,8 @@
 module empm_partition
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
-  use empm_error, only: empm_error_t, empm_raise_error
+  use empm_error, only: empm_error_t, empm_raise_error, empm_alloc_error
+  use empm_strings, only: str
   use empm_model, only: empm_model_t
   use empm_particles, only: PARTICLE_FIELDS
   use empm_loads, only: empm_traction_t
@@ -190,36 +191,52 @@ contains
 
   ! Every particle to process dest(p), each process's then in id order, as the set was made
   ! (runs of one material stay together), with the storage of their basis; the empty-node
-  ! threshold kept; tractions follow their particles by id. Field by field (the id first), each
-  ! field's storage released once taken: a process holds one field twice at most. Collective.
+  ! threshold kept; tractions follow their particles by id. A failure (out of memory) on one
+  ! process is everyone's: the callers' next steps are collective. Collective.
   subroutine move_particles(model, dest, e)
     type(empm_model_t), intent(inout) :: model
     integer, intent(in) :: dest(:)
     type(empm_error_t), intent(inout) :: e
+    real(wp) :: mass_tol
+    logical :: ok
+    call exchange_fields(model, dest, ok)
+    if (ok) then
+      mass_tol = model%nodes%mass_tol
+      call model%set_runs(e)
+      model%nodes%mass_tol = mass_tol
+    else
+      e = empm_alloc_error('particle storage ('//str(model%pts%np)//' particles moved '// &
+        'between processes)', 8_int64 * model%pts%row_size() * model%pts%np, '')
+    end if
+    call model%comm%agree(e)
+    if (e%code /= 0) return
+    call empm_share_traction_state(model)
+    call map_tractions(model)
+  end subroutine move_particles
+
+  ! Every particle to process dest(p), field by field (the id first), each process's then in id
+  ! order; each field's storage released once sent, so that a process holds a few copies of
+  ! one field at a time, not its set twice. `ok` is false on a process that ran out of memory
+  ! (it takes part in the remaining exchanges, which are collective).
+  subroutine exchange_fields(model, dest, ok)
+    type(empm_model_t), intent(inout) :: model
+    integer, intent(in) :: dest(:)
+    logical, intent(out) :: ok
     real(wp), allocatable :: cols(:,:), got(:,:)
     integer, allocatable :: order(:)
     integer :: f, np
-    real(wp) :: mass_tol
     np = model%pts%np
+    ok = .true.
     do f = 1, PARTICLE_FIELDS
       call model%pts%take_field(f, cols)
       call model%comm%exchange_rows(cols, np, dest, got)
       deallocate(cols)
       if (f == 1) order = id_order(nint(got(1, :)))
-      call model%pts%put_field(f, got, order)
+      if (ok) call model%pts%put_field(f, got, order, ok)
       deallocate(got)
     end do
     model%pts%np = size(order)
-    mass_tol = model%nodes%mass_tol
-    call model%set_runs(e)
-    ! A failure (out of memory) on one process is everyone's: the callers' next steps are
-    ! collective.
-    call model%comm%agree(e)
-    if (e%code /= 0) return
-    model%nodes%mass_tol = mass_tol
-    call empm_share_traction_state(model)
-    call map_tractions(model)
-  end subroutine move_particles
+  end subroutine exchange_fields
 
   !> Every process gets the tractions' shape-function state (λ at each face centre, which
   !> only the process holding the particle updates, as `part` still says): after the
@@ -402,8 +419,8 @@ contains
     real(wp), allocatable :: rows(:,:), all(:,:)
     integer, allocatable :: dest(:), order(:)
     type(empm_error_t) :: e
-    integer :: m, np, k, nd, ns, oid, first, last, ntotal, f
-    logical :: by_block
+    integer :: m, np, k, nd, ns, oid, first, last, ntotal
+    logical :: by_block, ok
     if (.not. model%comm%parallel()) return
     by_block = .false.
     if (present(blocks)) by_block = blocks
@@ -420,24 +437,13 @@ contains
       call gather_snapshot(hist%snap(k))
     end do
     if (by_block) then
-      ! Field by field (the id first), each field's storage released once taken: a process
-      ! holds one field twice at most, not its whole set.
+      ! Field by field (exchange_fields): a process holds a few copies of one field at a
+      ! time, not its whole set twice.
       dest = [(owner(model%pts%id(k)), k = 1, np)]
-      do f = 1, PARTICLE_FIELDS
-        call model%pts%take_field(f, rows)
-        call model%comm%exchange_rows(rows, np, dest, all)
-        deallocate(rows)
-        if (f == 1) then
-          ! Particle k of the block is id first + k − 1.
-          allocate(order(last - first + 1))
-          do k = 1, size(all, 2)
-            order(nint(all(1, k)) - first + 1) = k
-          end do
-        end if
-        call model%pts%put_field(f, all, order)
-        deallocate(all)
-      end do
-      model%pts%np = size(order)
+      call exchange_fields(model, dest, ok)
+      if (.not. ok) call empm_raise_error(empm_alloc_error('particle storage ('// &
+        str(model%pts%np)//' particles, a block of ids for the output)', &
+        8_int64 * model%pts%row_size() * model%pts%np, ''), err)
       ! A block is written and dropped: it needs no material runs nor basis storage.
       return
     end if

@@ -353,8 +353,8 @@ contains
 
   !> Field f (1..PARTICLE_FIELDS; 1 is the id) of particles 1..np as columns, one per
   !> particle (integers as reals), and the field's storage released: a set moved field by
-  !> field to other processes holds one field twice at most, not the whole set
-  !> ([[particles_put_field]]).
+  !> field to other processes holds a few copies of one field at a time, not the whole set
+  !> twice ([[particles_put_field]]).
   subroutine particles_take_field(self, f, cols)
     class(empm_particles_t), intent(inout) :: self     !! particles (field f released)
     integer, intent(in) :: f                           !! field, 1..PARTICLE_FIELDS
@@ -397,37 +397,57 @@ contains
 
   !> Field f of a set of n particles from columns (those of [[particles_take_field]], in the
   !> new set's order: particle k from column order(k)). The caller sets `np` = n once every
-  !> field is put (each field is taken with the old `np`).
-  subroutine particles_put_field(self, f, cols, order)
+  !> field is put (each field is taken with the old `np`). Out of memory: `ok` false and the
+  !> field left unallocated.
+  subroutine particles_put_field(self, f, cols, order, ok)
     class(empm_particles_t), intent(inout) :: self     !! particles (field f replaced)
     integer, intent(in) :: f                           !! field, 1..PARTICLE_FIELDS
     real(wp), intent(in) :: cols(:,:)                  !! values (width, >= maxval(order))
     integer, intent(in) :: order(:)                    !! column of each particle
-    integer :: n
-    n = size(order)
+    logical, intent(out) :: ok                         !! the field's storage was allocated
+    integer :: n, st
+    n = size(order); st = 0
     select case (f)
-    case (1); self%id = nint(cols(1, order))
-    case (2); self%x = cols(:, order)
-    case (3); self%x0 = cols(:, order)
-    case (4); self%v = cols(:, order)
-    case (5); self%a = cols(:, order)
-    case (6); self%dx = cols(:, order)
-    case (7); self%m = cols(1, order)
-    case (8); self%vol = cols(1, order)
-    case (9); self%vol0 = cols(1, order)
-    case (10); self%rho = cols(1, order)
-    case (11); self%stress = cols(:, order)
-    case (12); self%strain = cols(:, order)
-    case (13); self%F = reshape(cols(:, order), [3, 3, n])
-    case (14); self%lp = cols(:, order)
-    case (15); self%lam = cols(:, order)
-    case (16); self%lam_old = cols(:, order)
-    case (17); self%lam_prev = cols(:, order)
-    case (18); self%lam_old_prev = cols(:, order)
-    case (19); self%vol_fill = cols(1, order)
-    case (20); self%mat = nint(cols(1, order))
-    case (21); self%state = cols(:, order)
+    case (1)
+      allocate(self%id(n), stat=st)
+      if (st == 0) self%id = nint(cols(1, order))
+    case (2); call put2(self%x)
+    case (3); call put2(self%x0)
+    case (4); call put2(self%v)
+    case (5); call put2(self%a)
+    case (6); call put2(self%dx)
+    case (7); call put1(self%m)
+    case (8); call put1(self%vol)
+    case (9); call put1(self%vol0)
+    case (10); call put1(self%rho)
+    case (11); call put2(self%stress)
+    case (12); call put2(self%strain)
+    case (13)
+      allocate(self%F(3, 3, n), stat=st)
+      if (st == 0) self%F = reshape(cols(:, order), [3, 3, n])
+    case (14); call put2(self%lp)
+    case (15); call put2(self%lam)
+    case (16); call put2(self%lam_old)
+    case (17); call put2(self%lam_prev)
+    case (18); call put2(self%lam_old_prev)
+    case (19); call put1(self%vol_fill)
+    case (20)
+      allocate(self%mat(n), stat=st)
+      if (st == 0) self%mat = nint(cols(1, order))
+    case (21); call put2(self%state)
     end select
+    ok = st == 0
+  contains
+    subroutine put1(a)
+      real(wp), allocatable, intent(inout) :: a(:)
+      allocate(a(n), stat=st)
+      if (st == 0) a = cols(1, order)
+    end subroutine put1
+    subroutine put2(a)
+      real(wp), allocatable, intent(inout) :: a(:,:)
+      allocate(a(size(cols, 1), n), stat=st)
+      if (st == 0) a = cols(:, order)
+    end subroutine put2
   end subroutine particles_put_field
 
   !> Keep particles idx(1), idx(2), ... (increasing), in that order, as particles 1, 2, ...;
