@@ -1229,7 +1229,7 @@ contains
             if (all(x(1:nd, q) >= lo(1:nd) - tol .and. x(1:nd, q) <= hi(1:nd) + tol)) then
               cnt = cnt + 1; tr%part(cnt) = q
               tr%offset(cnt) = max(tr%side * (plane - x(ax, q)), 0.0_wp)
-              if (tr%offset(cnt) > 2.0_wp * pts%lp(ax, q) + tol .and. bad == 0) bad = q
+              if (tr%offset(cnt) > 2.0_wp * pts%lp(ax, q) + tol .and. bad == 0) bad = cnt
               ! Face area: the domain's side lengths across the normal (per unit thickness).
               tr%area(cnt) = 1.0_wp
               do d = 1, nd
@@ -1238,16 +1238,15 @@ contains
             end if
           end do
           badid = huge(1)
-          if (bad > 0) badid = pts%id(bad)
+          if (bad > 0) badid = pts%id(tr%part(bad))
           badid = cs%model%comm%min_int(badid)
           if (badid < huge(1)) then
             if (bad > 0) then
-              if (pts%id(bad) == badid) then
-                text = 'particle '//str(badid)//' lies '// &
-                  str(max(tr%side * (plane - x(ax, bad)), 0.0_wp))// &
+              if (pts%id(tr%part(bad)) == badid) then
+                text = 'particle '//str(badid)//' lies '//str(tr%offset(bad))// &
                   ' m inside the loaded face (the box''s '// &
                   merge('upper', 'lower', tr%side > 0)//' side along '//face(2:2)// &
-                  '), more than its size '//str(2.0_wp * pts%lp(ax, bad))// &
+                  '), more than its size '//str(2.0_wp * pts%lp(ax, tr%part(bad)))// &
                   ': the box must select the outer layer of particles only ('//name//')'
               end if
             end if
@@ -1317,14 +1316,10 @@ contains
         ! the nearest).
         associate (pts => cs%model%pts, comm => cs%model%comm)
           dist = sum((pts%x(:, 1:pts%np) - spread(point(1:nd), 2, pts%np))**2, dim=1)
+          dmin = comm%min_real(minval(dist)) ! huge on a process without particles
           q = huge(1)
           if (pts%np > 0) then
             i = minloc(dist, dim=1)
-            dmin = comm%min_real(dist(i))
-          else
-            dmin = comm%min_real(huge(1.0_wp))
-          end if
-          if (pts%np > 0) then
             if (dist(i) == dmin) q = pts%id(i)
           end if
           q = comm%min_int(q)
