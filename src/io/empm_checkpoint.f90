@@ -3,9 +3,10 @@
 !>
 !> A checkpoint holds every particle array (the integrators and the LME warm start keep their
 !> memory there), the time, step and residual, the surface tractions' shape-function state,
-!> the time loop's progress ([[empm_solver_state_t]]), and the histories and snapshots so far,
-!> so that the results file written at the end of a restarted run equals the uninterrupted
-!> run's. It also records the program version, the full text of the case file and the number of
+!> the time loop's progress ([[empm_solver_state_t]]), the histories so far and where the
+!> snapshots so far are (their files, or the results file's groups: a restart copies them from
+!> there), so that the results file written at the end of a restarted run equals the
+!> uninterrupted run's. It also records the program version, the full text of the case file and the number of
 !> threads. A checkpoint is written under a unique partial name and renamed: `OUT.ckpt.h5`, the
 !> previous one kept as `OUT.ckpt.prev.h5` (the last two). Reading one refuses, with an input
 !> error saying why, a file that is not an empm checkpoint, one written by another version, for
@@ -23,7 +24,7 @@ module empm_checkpoint
   use empm_version_info, only: empm_version
   use empm_parallel, only: empm_max_threads
   use empm_model, only: empm_model_t
-  use empm_history, only: empm_history_t
+  use empm_history, only: empm_history_t, empm_snapshot_t
   use empm_solver, only: empm_solver_state_t
   use empm_particle_gen, only: empm_deal_t
   use empm_output, only: empm_shared_file_t
@@ -32,7 +33,8 @@ module empm_checkpoint
   public :: empm_checkpoint_write, empm_checkpoint_read, empm_checkpoint_path
 
   character(len=*), parameter :: FORMAT_NAME = 'empm checkpoint'
-  integer, parameter :: FORMAT_VERSION = 1
+  ! 2: snapshots named (their files), not held
+  integer, parameter :: FORMAT_VERSION = 2
 
 contains
 
@@ -59,13 +61,17 @@ contains
   !> `path` becomes the previous checkpoint (`prev`), replacing the one before. `together`:
   !> called by all processes, each holding a block of consecutive ids, as
   !> [[empm_write_results]]; the error is the root's.
-  subroutine empm_checkpoint_write(path, prev, model, hist, state, case_text, err, together)
+  subroutine empm_checkpoint_write(path, prev, model, hist, state, case_text, results, err, &
+                                   together)
     character(len=*), intent(in) :: path               !! checkpoint file
     character(len=*), intent(in) :: prev               !! where the previous one goes
     type(empm_model_t), intent(in) :: model            !! the state after a completed step
     type(empm_history_t), intent(in) :: hist           !! histories and snapshots so far
     type(empm_solver_state_t), intent(in) :: state     !! the time loop's progress
     character(len=*), intent(in) :: case_text          !! full text of the case file
+    character(len=*), intent(in) :: results            !! the run's results file (a restart
+                                                       !! finds the snapshots there when
+                                                       !! their own files are gone)
     type(empm_error_t), intent(out) :: err             !! error (EMPM_ERR_IO), if any
     logical, intent(in), optional :: together          !! all processes write it (blocks)
     integer(hid_t) :: fid, g, gs, gk
@@ -86,6 +92,7 @@ contains
     call h5_attr(fid, 'format', FORMAT_NAME, ierr)
     call h5_attr(fid, 'format_version', FORMAT_VERSION, ierr)
     call h5_attr(fid, 'empm_version', empm_version(), ierr)
+    call h5_attr(fid, 'results', relative_to(folder_of(path), results), ierr)
     call h5_attr(fid, 'case_text', case_text, ierr)
     ! The root's (an attribute of a file written together is the same on every process).
     th(1) = empm_max_threads()
@@ -170,19 +177,19 @@ contains
         end if
       end if
     end if
+    ! The snapshots stay in their files (empm_run_case writes each as it is taken): their
+    ! names, relative to the checkpoint's folder.
     call h5_group(g, 'snapshots', gs, ierr)
     do k = 1, hist%nsnap
       call h5_group(gs, str(k), gk, ierr)
       associate (sn => hist%snap(k))
         call h5_write(gk, 'scalars', [sn%t, real(sn%step, wp)], ierr, sf%sh)
-        call h5_write(gk, 'x', sn%x, ierr, sf%pp)
-        call h5_write(gk, 'v', sn%v, ierr, sf%pp)
-        call h5_write(gk, 'stress', sn%stress, ierr, sf%pp)
-        call h5_write(gk, 'strain', sn%strain, ierr, sf%pp)
-        call h5_write(gk, 'm', sn%m, ierr, sf%pp)
-        call h5_write(gk, 'vol', sn%vol, ierr, sf%pp)
-        call h5_write(gk, 'rho', sn%rho, ierr, sf%pp)
-        if (model%pts%nstate > 0) call h5_write(gk, 'state', sn%state, ierr, sf%pp)
+        if (allocated(sn%file)) then
+          call h5_attr(gk, 'file', relative_to(folder_of(path), sn%file), ierr)
+          call h5_attr(gk, 'frame', sn%frame, ierr)
+        else
+          ierr = 1 ! held in memory: only a run that streams its snapshots checkpoints
+        end if
       end associate
       call h5_close_group(gk, ierr)
     end do
@@ -231,10 +238,10 @@ contains
     integer(hid_t) :: fid, g, gs, gk
     integer :: cols(2), ntotal
     logical :: share
-    character(len=:), allocatable :: s
+    character(len=:), allocatable :: s, results
     real(wp), allocatable :: r1(:), r2(:,:)
     real(wp) :: sc(7), cnt(5)
-    integer :: ierr, e, n, nd, k, nt, np, ns, threads
+    integer :: ierr, e, n, nd, k, nt, np, ns, threads, fv
     warning = ''
     ! Failures are ours to report, once: not HDF5's error stacks (a damaged file).
     call h5open_f(e)
@@ -253,6 +260,11 @@ contains
     if (ierr /= 0 .or. s /= FORMAT_NAME) then
       call refuse('not an empm checkpoint (no "format" attribute saying so)'); return
     end if
+    call h5_read_attr(fid, 'format_version', fv, ierr)
+    if (ierr /= 0 .or. fv /= FORMAT_VERSION) then
+      call refuse('its format version is '//str(fv)//', this empm reads version '// &
+        str(FORMAT_VERSION)); return
+    end if
     call h5_read_attr(fid, 'empm_version', s, ierr)
     if (ierr /= 0) then
       call refuse('it has no empm_version attribute'); return
@@ -267,6 +279,10 @@ contains
     end if
     if (s /= case_text) then
       call refuse('written for another case file: '//first_difference(s, case_text)); return
+    end if
+    call h5_read_attr(fid, 'results', results, ierr)
+    if (ierr /= 0) then
+      call refuse('it has no results attribute'); return
     end if
     np = int_attr('particles'); nd = int_attr('ndim'); ns = int_attr('nstate')
     threads = int_attr('threads')
@@ -357,6 +373,7 @@ contains
       call refuse('its probes or snapshots do not match the case file'); return
     end if
     call restore_history()
+    if (err%code /= 0) return
     call h5_close_group(g, ierr)
     call h5_close_file(fid, ierr)
     if (ierr /= 0) then
@@ -365,6 +382,16 @@ contains
     end if
 
   contains
+
+    ! A name the checkpoint holds relative to its own folder (wherever the restart runs from).
+    function resolved(rel) result(file)
+      character(len=*), intent(in) :: rel
+      character(len=:), allocatable :: file
+      file = rel
+      if (len(rel) > 0) then
+        if (rel(1:1) /= '/') file = folder_of(path)//rel
+      end if
+    end function resolved
 
     subroutine refuse(why)
       character(len=*), intent(in) :: why
@@ -402,7 +429,10 @@ contains
 
     ! The histories as recorded up to the checkpoint, in arrays with room to grow.
     subroutine restore_history()
-      integer :: c, np_, d, ks, kid
+      character(len=:), allocatable :: rel, fr, why, why_alt
+      character(len=6) :: num
+      type(empm_snapshot_t) :: alt
+      integer :: c, np_, d, ks
       real(wp) :: ssc(2)
       d = size(hist%px, 1); np_ = hist%nprobe
       c = max(size(hist%t), nt, 16)
@@ -451,44 +481,95 @@ contains
         end if
       end if
       hist%nsnap = nint(cnt(3))
+      why = ''
       call open_group(g, 'snapshots', gs)
       do ks = 1, hist%nsnap
         call open_group(gs, str(ks), gk)
         associate (sn => hist%snap(ks))
           call h5_read(gk, 'scalars', ssc, ierr)
           sn%t = ssc(1); sn%step = nint(ssc(2))
-          call read2(gk, 'x', d, n, sn%x); call read2(gk, 'v', d, n, sn%v)
-          call read2(gk, 'stress', 6, n, sn%stress)
-          call read2(gk, 'strain', 6, n, sn%strain)
-          call read1(gk, 'm', n, sn%m); call read1(gk, 'vol', n, sn%vol)
-          call read1(gk, 'rho', n, sn%rho)
-          call read2(gk, 'state', ns, n, sn%state)
-          ! A checkpoint holds every particle in id order; dealt out, this process's ids.
-          sn%id = [(cols(1) + 1 + cols(2) * (kid - 1), kid = 1, n)]
+          call h5_read_attr(gk, 'file', rel, ierr)
+          call h5_read_attr(gk, 'frame', fr, ierr)
+          if (ierr /= 0) exit
+          sn%frame = trim(fr) ! '' is stored as ' '
+          sn%file = resolved(rel)
+          why = snapshot_problem(sn, np)
+          if (len(why) > 0) then
+            ! Its own file is gone once the run's results hold it (a run that ended, or was
+            ! stopped by a signal): taken from there.
+            alt%t = sn%t; alt%step = sn%step; alt%file = resolved(results)
+            write(num, '(i6.6)') ks - 1
+            alt%frame = '/snapshots/'//num
+            why_alt = snapshot_problem(alt, np)
+            if (len(why_alt) == 0) then
+              sn%file = alt%file; sn%frame = alt%frame; why = ''
+            else
+              why = 'neither in '//sn%file//', which '//why//', nor in the results '// &
+                alt%file//', which '//why_alt
+            end if
+          end if
         end associate
         call h5_close_group(gk, ierr)
+        if (len(why) > 0) exit
       end do
       call h5_close_group(gs, ierr)
+      if (len(why) > 0) then
+        call h5_close_group(g, ierr)
+        call refuse('its snapshot '//str(ks - 1)//' (t = '//str(hist%snap(ks)%t)// &
+          ' s) is '//why); return
+      end if
     end subroutine restore_history
-
-    subroutine read1(loc, name, m, a)
-      integer(hid_t), intent(in) :: loc
-      character(len=*), intent(in) :: name
-      integer, intent(in) :: m
-      real(wp), allocatable, intent(out) :: a(:)
-      allocate(a(m))
-      if (m > 0) call h5_read(loc, name, a, ierr, cols)
-    end subroutine read1
-
-    subroutine read2(loc, name, m1, m2, a)
-      integer(hid_t), intent(in) :: loc
-      character(len=*), intent(in) :: name
-      integer, intent(in) :: m1, m2
-      real(wp), allocatable, intent(out) :: a(:,:)
-      allocate(a(m1, m2))
-      if (m1 * m2 > 0) call h5_read(loc, name, a, ierr, cols)
-    end subroutine read2
   end subroutine empm_checkpoint_read
+
+  ! '' when group `sn%frame` of `sn%file` holds the snapshot `sn` (its time and step) of `np`
+  ! particles, else why not (words following "which").
+  function snapshot_problem(sn, np) result(why)
+    use hdf5, only: h5gopen_f, h5gclose_f, hsize_t
+    type(empm_snapshot_t), intent(in) :: sn
+    integer, intent(in) :: np
+    character(len=:), allocatable :: why
+    integer(hid_t) :: fid, loc
+    integer(hsize_t), allocatable :: dims(:)
+    integer :: e, step, ie
+    real(wp) :: t(1)
+    why = ''
+    call h5_open_read(sn%file, fid, e)
+    select case (e)
+    case (1)
+      why = 'is missing'; return
+    case (2, 3)
+      why = 'is not a readable HDF5 file'; return
+    end select
+    loc = fid
+    if (len(sn%frame) > 0) call h5gopen_f(fid, sn%frame, loc, e)
+    if (e == 0) call h5_read_attr(loc, 'step', step, e)
+    if (e == 0) call h5_read_attr(loc, 'time', t, e)
+    if (e == 0) call h5_dims(loc, 'mass', dims, e)
+    if (loc /= fid .and. e == 0) call h5gclose_f(loc, ie)
+    call h5_close_file(fid, ie)
+    if (e /= 0) then
+      why = 'has no snapshot at "'//sn%frame//'/"'
+    else if (step /= sn%step .or. t(1) /= sn%t .or. any(dims /= np)) then
+      why = 'holds another (step '//str(step)//', t = '//str(t(1))//' s)'
+    end if
+  end function snapshot_problem
+
+  ! The folder part of `path`, with its final '/' ('' for a bare name).
+  pure function folder_of(path) result(dir)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable :: dir
+    dir = path(1:index(path, '/', back=.true.))
+  end function folder_of
+
+  ! `file` relative to the folder `dir` (as folder_of gives it) when it lies there, else as is.
+  pure function relative_to(dir, file) result(rel)
+    character(len=*), intent(in) :: dir, file
+    character(len=:), allocatable :: rel
+    rel = file
+    if (len(dir) > 0) then
+      if (index(file, dir) == 1) rel = file(len(dir) + 1:)
+    end if
+  end function relative_to
 
   !> 'line N: "..." here, "..." in the checkpoint' for the first line where two texts differ.
   pure function first_difference(saved, now) result(msg)

@@ -3,14 +3,15 @@
 module empm_driver
   use, intrinsic :: iso_fortran_env, only: error_unit, int64
   use empm_error, only: empm_error_t, empm_raise_error, EMPM_OK, EMPM_ERR_INTERRUPTED, &
-                        EMPM_ERR_INPUT
+                        EMPM_ERR_INPUT, EMPM_ERR_IO
   use empm_case, only: empm_case_t
   use empm_input, only: empm_read_case, empm_check_basis
   use empm_model, only: empm_model_t
-  use empm_history, only: empm_history_t
+  use empm_history, only: empm_history_t, empm_snapshot_t
   use empm_solver, only: empm_solve, empm_run_stats_t, empm_run_hook_t, empm_solver_state_t
   use empm_output, only: empm_write_results, empm_output_meta_t, empm_output_claim, &
-    empm_output_release
+    empm_output_release, empm_write_snapshot_file, empm_staging_path
+  use empm_files, only: empm_mkdir_p, empm_remove
   use empm_checkpoint, only: empm_checkpoint_write, empm_checkpoint_read, empm_checkpoint_path
   use empm_posix, only: empm_stop_signal, empm_sleep
   use empm_parallel, only: empm_cpu_sample_t, empm_cpu_sample, empm_threads_for_load, &
@@ -18,7 +19,8 @@ module empm_driver
   use empm_strings, only: str
   use empm_kinds, only: wp
   use empm_comm, only: empm_comm_t
-  use empm_partition, only: empm_partition_particles, empm_gather_particles, empm_copy_for_output
+  use empm_partition, only: empm_partition_particles, empm_gather_particles, &
+    empm_copy_for_output, empm_gather_snapshot
   use empm_h5_mpio, only: empm_h5_collective
   implicit none
   private
@@ -30,9 +32,12 @@ module empm_driver
     character(len=:), allocatable :: path       ! OUT.ckpt.h5
     character(len=:), allocatable :: prev       ! OUT.ckpt.prev.h5
     character(len=:), allocatable :: case_text  ! the case file's text
+    character(len=:), allocatable :: staging    ! OUT.snapshots: each snapshot as taken
+    character(len=:), allocatable :: results    ! OUT.h5
   contains
     procedure :: checkpoint => hook_checkpoint
     procedure :: stop_requested => hook_stop
+    procedure :: snapshot => hook_snapshot
   end type driver_hook_t
 
 contains
@@ -47,7 +52,8 @@ contains
     type(empm_history_t) :: hwhole
     logical :: together
     if (.not. model%comm%parallel()) then
-      call empm_checkpoint_write(self%path, self%prev, model, hist, state, self%case_text, err)
+      call empm_checkpoint_write(self%path, self%prev, model, hist, state, self%case_text, &
+        self%results, err)
       return
     end if
     ! Several processes: one checkpoint with every particle in id order (as a serial run's),
@@ -60,8 +66,8 @@ contains
     call empm_gather_particles(whole, hwhole, err, blocks=together)
     if (together) call model%comm%agree(err)
     if (err%code == EMPM_OK .and. (together .or. model%comm%is_root())) &
-      call empm_checkpoint_write(self%path, self%prev, whole, hwhole, state, self%case_text, err, &
-      together)
+      call empm_checkpoint_write(self%path, self%prev, whole, hwhole, state, self%case_text, &
+      self%results, err, together)
     call model%comm%agree(err)
   end subroutine hook_checkpoint
 
@@ -87,6 +93,49 @@ contains
       call empm_write_results(path, model, hist, meta, complete, status, err, together)
     call model%comm%agree(err)
   end subroutine empm_write_shared
+
+  ! Each snapshot goes to its own file in the staging folder as it is taken (written by the
+  ! processes together, each a block of ids, or by the root), and the record keeps its name
+  ! only: a run holds no snapshot in memory (docs/output.md, "Memory"). The results file
+  ! copies them at the end.
+  subroutine hook_snapshot(self, model, hist, err)
+    class(driver_hook_t), intent(inout) :: self
+    type(empm_model_t), intent(in) :: model
+    type(empm_history_t), intent(inout) :: hist
+    type(empm_error_t), intent(out) :: err
+    type(empm_snapshot_t) :: sn
+    character(len=:), allocatable :: file
+    character(len=16) :: name
+    logical :: together
+    integer :: n
+    if (hist%nsnap >= size(hist%snap)) return
+    write(name, '(i6.6)') hist%nsnap
+    file = self%staging//'/'//trim(name)//'.h5'
+    n = model%pts%np
+    if (.not. model%comm%parallel()) then
+      ! Straight from the particles.
+      associate (p => model%pts)
+        call empm_write_snapshot_file(file, model, model%t, model%step, p%x(:, 1:n), &
+          p%x0(:, 1:n), p%v(:, 1:n), p%stress(:, 1:n), p%strain(:, 1:n), p%m(1:n), &
+          p%vol(1:n), p%rho(1:n), p%state(:, 1:n), p%mat(1:n), .false., err)
+      end associate
+    else
+      ! A copy of this process's particles goes to the block of their ids (or the root).
+      together = empm_h5_collective(model%comm)
+      associate (p => model%pts)
+        sn%x = p%x(:, 1:n); sn%x0 = p%x0(:, 1:n); sn%v = p%v(:, 1:n)
+        sn%stress = p%stress(:, 1:n); sn%strain = p%strain(:, 1:n)
+        sn%m = p%m(1:n); sn%vol = p%vol(1:n); sn%rho = p%rho(1:n)
+        sn%state = p%state(:, 1:n); sn%mat = p%mat(1:n); sn%id = p%id(1:n)
+      end associate
+      call empm_gather_snapshot(model%comm, sn, together)
+      if (together .or. model%comm%is_root()) &
+        call empm_write_snapshot_file(file, model, model%t, model%step, sn%x, sn%x0, sn%v, &
+        sn%stress, sn%strain, sn%m, sn%vol, sn%rho, sn%state, sn%mat, together, err)
+      call model%comm%agree(err)
+    end if
+    if (err%code == EMPM_OK) call hist%add_staged(model%t, model%step, file)
+  end subroutine hook_snapshot
 
   integer function hook_stop(self) result(sig)
     class(driver_hook_t), intent(inout) :: self
@@ -187,8 +236,19 @@ contains
         call empm_raise_error(e, err); return
       end if
     end if
-    ! The root claims the output for all (one file, one lock); its verdict is everyone's.
-    if (cs%model%comm%is_root()) call empm_output_claim(cs%output_file, e)
+    ! The root claims the output for all (one file, one lock), and makes the folder the
+    ! snapshots go to as they are taken; its verdict is everyone's.
+    hook%staging = empm_staging_path(cs%output_file); hook%results = cs%output_file
+    if (cs%model%comm%is_root()) then
+      call empm_output_claim(cs%output_file, e)
+      if (e%code == EMPM_OK) then
+        if (empm_mkdir_p(hook%staging) /= 0) then
+          call release()
+          call e%set(EMPM_ERR_IO, cs%output_file//': cannot create the folder '// &
+            hook%staging//' for its snapshots')
+        end if
+      end if
+    end if
     call cs%model%comm%agree(e)
     if (e%code /= EMPM_OK) then
       call empm_raise_error(e, err); return
@@ -241,6 +301,8 @@ contains
     else
       call empm_write_shared(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
     end if
+    ! The snapshots are in the results now (a restart takes them from there).
+    if (ew%code == EMPM_OK) call unstage()
     call release()
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then
@@ -261,9 +323,25 @@ contains
 
   contains
 
-    ! The root releases the output it claimed.
+    ! The root removes the snapshot files of this run's folder (a killed run's too, which a
+    ! restart names otherwise), and the folder when empty.
+    subroutine unstage()
+      integer :: k, info
+      character(len=6) :: name
+      if (.not. cs%model%comm%is_root()) return
+      do k = 1, hist%nsnap
+        write(name, '(i6.6)') k - 1
+        info = empm_remove(hook%staging//'/'//name//'.h5')
+      end do
+      info = empm_remove(hook%staging)
+    end subroutine unstage
+
+    ! The root releases the output it claimed (and the snapshot folder, when empty).
     subroutine release()
-      if (cs%model%comm%is_root()) call empm_output_release(cs%output_file)
+      integer :: info
+      if (.not. cs%model%comm%is_root()) return
+      call empm_output_release(cs%output_file)
+      if (allocated(hook%staging)) info = empm_remove(hook%staging)
     end subroutine release
 
     ! Threads for a run that can use them (EMPM_OMP_MIN_PARTICLES or more): the cores other

@@ -48,7 +48,7 @@ module empm_h5
 
   !> Read an attribute (a string).
   interface h5_read_attr
-    module procedure read_attr_s
+    module procedure read_attr_s, read_attr_i, read_attr_r
   end interface h5_read_attr
 
 contains
@@ -409,5 +409,56 @@ contains
     if (e /= 0) ierr = 1
     call h5tclose_f(tid, e); call h5aclose_f(aid, e)
   end subroutine read_attr_s
+
+  !> Read the scalar integer attribute `name` of `loc`; `ierr` set non-zero when it is
+  !> missing or cannot be read as an integer.
+  subroutine read_attr_i(loc, name, i, ierr)
+    integer(hid_t), intent(in) :: loc                !! file, group or dataset
+    character(len=*), intent(in) :: name             !! attribute
+    integer, intent(out) :: i                        !! its value
+    integer, intent(inout) :: ierr                   !! set non-zero on failure
+    integer(hid_t) :: aid
+    integer(hsize_t) :: dims(1)
+    integer :: buf(1), e
+    logical :: there
+    i = 0; dims = 1
+    call h5aexists_f(loc, name, there, e)
+    if (e /= 0 .or. .not. there) then
+      ierr = 1; return
+    end if
+    call h5aopen_f(loc, name, aid, e)
+    if (e /= 0) then
+      ierr = 1; return
+    end if
+    call h5aread_f(aid, H5T_NATIVE_INTEGER, buf, dims, e)
+    if (e /= 0) ierr = 1
+    i = buf(1)
+    call h5aclose_f(aid, e)
+  end subroutine read_attr_i
+
+  !> Read the real attribute `name` of `loc` (as many values as `x` holds: 1 for a scalar);
+  !> `ierr` set non-zero when it is missing or cannot be read.
+  subroutine read_attr_r(loc, name, x, ierr)
+    integer(hid_t), intent(in) :: loc                !! file, group or dataset
+    character(len=*), intent(in) :: name             !! attribute
+    real(wp), intent(out) :: x(:)                    !! its values
+    integer, intent(inout) :: ierr                   !! set non-zero on failure
+    integer(hid_t) :: aid
+    integer(hsize_t) :: dims(1)
+    integer :: e
+    logical :: there
+    x = 0.0_wp; dims = size(x, kind=hsize_t)
+    call h5aexists_f(loc, name, there, e)
+    if (e /= 0 .or. .not. there) then
+      ierr = 1; return
+    end if
+    call h5aopen_f(loc, name, aid, e)
+    if (e /= 0) then
+      ierr = 1; return
+    end if
+    call h5aread_f(aid, H5T_NATIVE_DOUBLE, x, dims, e)
+    if (e /= 0) ierr = 1
+    call h5aclose_f(aid, e)
+  end subroutine read_attr_r
 
 end module empm_h5

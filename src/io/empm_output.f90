@@ -27,7 +27,9 @@ module empm_output
   use hdf5, only: h5open_f, h5fcreate_f, h5fclose_f, H5F_ACC_EXCL_F, h5eset_auto_f, &
     h5dont_atexit_f
   use empm_kinds, only: wp
-  use empm_h5, only: hid_t, h5_group, h5_close_group, h5_write, h5_attr, h5_part_t
+  use empm_h5, only: hid_t, h5_group, h5_close_group, h5_write, h5_attr, h5_part_t, &
+    h5_open_read, h5_close_file, h5_read, h5_dims
+  use hdf5, only: hsize_t
   use empm_h5_mpio, only: empm_h5_collective, h5_mpio_properties, h5_mpio_close
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO, EMPM_ERR_INPUT
   use empm_files, only: empm_rename, empm_remove
@@ -43,6 +45,7 @@ module empm_output
   private
   public :: empm_write_results, empm_output_meta_t, empm_xdmf_path
   public :: empm_output_claim, empm_output_release, empm_partial_name, empm_shared_file_t
+  public :: empm_write_snapshot_file, empm_staging_path
 
   !> An HDF5 file written by the processes of a run: together (parallel HDF5, each process
   !> holding a block of consecutive particle ids, [[empm_h5_collective]]) or by one process.
@@ -94,7 +97,7 @@ contains
     logical, intent(in), optional :: together          !! all processes write it (blocks)
     integer(hid_t) :: fid, g, gs, gp
     integer :: ierr, e, k, info, n, oserr, np
-    character(len=:), allocatable :: tmp, xmf, xtmp, stat
+    character(len=:), allocatable :: tmp, xmf, xtmp, stat, why
     character(len=16) :: sname
     character(len=STATE_NAME_LEN), allocatable :: snames(:)
     integer, allocatable :: scol(:,:)
@@ -159,26 +162,24 @@ contains
     call h5_close_group(g, ierr)
 
     call h5_group(fid, 'snapshots', gs, ierr)
+    why = ''
     do k = 1, hist%nsnap
       write(sname, '(i6.6)') k - 1
       call h5_group(gs, trim(sname), g, ierr)
       call h5_attr(g, 'time', hist%snap(k)%t, ierr)
       call h5_attr(g, 'step', hist%snap(k)%step, ierr)
-      call h5_write(g, 'x', hist%snap(k)%x, ierr, sf%pp)
-      call h5_write(g, 'xyz', pad3(hist%snap(k)%x), ierr, sf%pp)
-      call h5_write(g, 'v', hist%snap(k)%v, ierr, sf%pp)
-      call h5_write(g, 'stress', hist%snap(k)%stress, ierr, sf%pp)
-      call h5_write(g, 'strain', hist%snap(k)%strain, ierr, sf%pp)
-      call h5_write(g, 'mass', hist%snap(k)%m, ierr, sf%pp)
-      call h5_write(g, 'volume', hist%snap(k)%vol, ierr, sf%pp)
-      call h5_write(g, 'density', hist%snap(k)%rho, ierr, sf%pp)
-      ! Particles keep their material for the whole run: the current indices apply.
-      n = min(size(hist%snap(k)%m), np)
-      if (allocated(hist%snap(k)%state)) call write_state_vars(g, hist%snap(k)%state(:, 1:n), &
-        model%pts%mat(1:n), snames, scol, sf%pp, ierr)
-      call write_xdmf_fields(g, hist%snap(k)%x(:, 1:n), model%pts%x0(:, 1:n), &
-        hist%snap(k)%v(:, 1:n), hist%snap(k)%stress(:, 1:n), hist%snap(k)%strain(:, 1:n), sf%pp, &
-        ierr)
+      associate (sn => hist%snap(k))
+        if (allocated(sn%file)) then
+          ! Written to its own file as it was taken: copied here, dataset by dataset.
+          call copy_frame(sn%file, sn%frame, g, sf, np, model%grid%ndim, snames, ierr, why)
+        else
+          ! Particles keep their material for the whole run: the current indices apply.
+          n = min(size(sn%m), np)
+          call write_frame(g, sn%x(:, 1:n), model%pts%x0(:, 1:n), sn%v(:, 1:n), &
+            sn%stress(:, 1:n), sn%strain(:, 1:n), sn%m(1:n), sn%vol(1:n), sn%rho(1:n), &
+            sn%state(:, 1:n), model%pts%mat(1:n), snames, scol, sf%pp, ierr)
+        end if
+      end associate
       call h5_close_group(g, ierr)
     end do
     call h5_close_group(gs, ierr)
@@ -222,8 +223,13 @@ contains
     if (.not. sf%root) return
     if (ierr /= 0) then
       info = empm_remove(tmp)
-      call empm_raise(EMPM_ERR_IO, path//': writing the HDF5 output '//tmp//' failed: '// &
-        empm_write_reason(oserr), err); return
+      if (len(why) > 0) then
+        call empm_raise(EMPM_ERR_IO, path//': cannot copy a snapshot into it: '//why, err)
+      else
+        call empm_raise(EMPM_ERR_IO, path//': writing the HDF5 output '//tmp//' failed: '// &
+          empm_write_reason(oserr), err)
+      end if
+      return
     end if
     xmf = empm_xdmf_path(path)
     xtmp = empm_partial_name(xmf)
@@ -376,6 +382,194 @@ contains
     call h5_write(g, 'density', pts%rho(1:n), ierr, pp)
     call h5_write(g, 'material', pts%mat(1:n), ierr, pp)
   end subroutine write_state
+
+  ! The datasets of a snapshot's frame group `g` (docs/output.md, "/snapshots").
+  subroutine write_frame(g, x, x0, v, stress, strain, m, vol, rho, state, mat, snames, scol, pp, &
+                         ierr)
+    integer(hid_t), intent(in) :: g
+    real(wp), intent(in) :: x(:,:), x0(:,:), v(:,:), stress(:,:), strain(:,:), m(:), vol(:), &
+      rho(:), state(:,:)
+    integer, intent(in) :: mat(:)
+    character(len=*), intent(in) :: snames(:)
+    integer, intent(in) :: scol(:,:)
+    type(h5_part_t), intent(in) :: pp
+    integer, intent(inout) :: ierr
+    call h5_write(g, 'x', x, ierr, pp)
+    call h5_write(g, 'xyz', pad3(x), ierr, pp)
+    call h5_write(g, 'v', v, ierr, pp)
+    call h5_write(g, 'stress', stress, ierr, pp)
+    call h5_write(g, 'strain', strain, ierr, pp)
+    call h5_write(g, 'mass', m, ierr, pp)
+    call h5_write(g, 'volume', vol, ierr, pp)
+    call h5_write(g, 'density', rho, ierr, pp)
+    call write_state_vars(g, state, mat, snames, scol, pp, ierr)
+    call write_xdmf_fields(g, x, x0, v, stress, strain, pp, ierr)
+  end subroutine write_frame
+
+  ! Copy the frame datasets of a snapshot (group `frame` of `file`, '' its root) into the
+  ! frame group `g`: this process's columns (sf%first on, np of them), one dataset at a time.
+  ! `why` says what failed when the snapshot cannot be read (ierr set).
+  subroutine copy_frame(file, frame, g, sf, np, nd, snames, ierr, why)
+    character(len=*), intent(in) :: file, frame
+    integer(hid_t), intent(in) :: g
+    type(empm_shared_file_t), intent(in) :: sf
+    integer, intent(in) :: np, nd
+    character(len=*), intent(in) :: snames(:)
+    integer, intent(inout) :: ierr
+    character(len=:), allocatable, intent(inout) :: why
+    integer(hid_t) :: src, gs
+    integer(hsize_t), allocatable :: dims(:)
+    integer :: e, k, rs
+    character(len=:), allocatable :: at
+    at = frame
+    if (len(at) > 0) at = at//'/'
+    call h5_open_read(file, src, e)
+    if (e == 0) then
+      call h5_dims(src, at//'mass', dims, e)
+      if (e == 0) then
+        if (size(dims) /= 1) then
+          e = 4
+        else if (dims(1) /= sf%ntotal) then
+          e = 4
+        end if
+      end if
+      if (e /= 0) call h5_close_file(src, k)
+    end if
+    if (e /= 0) then
+      ierr = 1
+      select case (e)
+      case (1); why = file//': no such file (the run wrote it as the snapshot was taken)'
+      case (2, 3); why = file//': not a readable HDF5 file'
+      case default; why = file//': no snapshot of the run''s particles at "'//frame//'"'
+      end select
+      return
+    end if
+    rs = 0
+    call copy('x', nd, g); call copy('xyz', 3, g); call copy('v', nd, g)
+    call copy('stress', 6, g); call copy('strain', 6, g)
+    call copy('mass', 0, g); call copy('volume', 0, g); call copy('density', 0, g)
+    if (size(snames) > 0) then
+      call h5_group(g, 'state', gs, ierr)
+      do k = 1, size(snames)
+        call copy('state/'//trim(snames(k)), 0, gs, trim(snames(k)))
+      end do
+      call h5_close_group(gs, ierr)
+    end if
+    call h5_group(g, 'xdmf', gs, ierr)
+    call copy('xdmf/displacement', 3, gs, 'displacement')
+    call copy('xdmf/velocity', 3, gs, 'velocity')
+    call copy('xdmf/stress', 9, gs, 'stress'); call copy('xdmf/strain', 9, gs, 'strain')
+    call h5_close_group(gs, ierr)
+    call h5_close_file(src, rs)
+    if (rs /= 0) then
+      ierr = 1
+      if (len(why) == 0) why = file//': closing it failed'
+    end if
+  contains
+    ! Dataset `name` of the frame (`rows` rows, 0: rank 1) as `dest` (default: `name`) of `loc`.
+    subroutine copy(name, rows, loc, dest)
+      character(len=*), intent(in) :: name
+      integer, intent(in) :: rows
+      integer(hid_t), intent(in) :: loc
+      character(len=*), intent(in), optional :: dest
+      real(wp), allocatable :: a1(:), a2(:,:)
+      character(len=:), allocatable :: to
+      integer :: r
+      to = name
+      if (present(dest)) to = dest
+      r = 0
+      if (rows == 0) then
+        allocate(a1(np))
+        call h5_read(src, at//name, a1, r, [sf%first, 1])
+        if (r == 0) call h5_write(loc, to, a1, ierr, sf%pp)
+      else
+        allocate(a2(rows, np))
+        call h5_read(src, at//name, a2, r, [sf%first, 1])
+        if (r == 0) call h5_write(loc, to, a2, ierr, sf%pp)
+      end if
+      if (r /= 0) then
+        ierr = 1
+        if (len(why) == 0) why = file//': cannot read its dataset '//at//name
+      end if
+    end subroutine copy
+  end subroutine copy_frame
+
+  !> Write one snapshot's frame to its own HDF5 file `path` (atomically: a partial name, then
+  !> renamed), at the root of the file, with the root attributes `format` = 'empm snapshot',
+  !> `time`, `step` and `particles`. Called by every process when `together` (each its block
+  !> of consecutive ids, as [[empm_write_results]]), else by one holding every particle. The
+  !> error is every process's.
+  subroutine empm_write_snapshot_file(path, model, t, step, x, x0, v, stress, strain, m, vol, &
+                                      rho, state, mat, together, err)
+    character(len=*), intent(in) :: path               !! the snapshot's file
+    type(empm_model_t), intent(in) :: model            !! the run (materials, processes)
+    real(wp), intent(in) :: t                          !! its time [s]
+    integer, intent(in) :: step                        !! its step
+    real(wp), intent(in) :: x(:,:)                     !! positions (ndim, np) [m]
+    real(wp), intent(in) :: x0(:,:)                    !! initial positions (ndim, np) [m]
+    real(wp), intent(in) :: v(:,:)                     !! velocities (ndim, np) [m/s]
+    real(wp), intent(in) :: stress(:,:)                !! stresses (6, np) [Pa]
+    real(wp), intent(in) :: strain(:,:)                !! strains (6, np)
+    real(wp), intent(in) :: m(:)                       !! masses (np) [kg]
+    real(wp), intent(in) :: vol(:)                     !! volumes (np) [m³]
+    real(wp), intent(in) :: rho(:)                     !! densities (np) [kg/m³]
+    real(wp), intent(in) :: state(:,:)                 !! state variables (nstate, np)
+    integer, intent(in) :: mat(:)                      !! material indices (np)
+    logical, intent(in) :: together                    !! all processes write it (blocks)
+    type(empm_error_t), intent(out) :: err             !! error, if any
+    integer(hid_t) :: fid
+    integer :: ierr, e, oserr, info, n
+    character(len=:), allocatable :: tmp
+    character(len=STATE_NAME_LEN), allocatable :: snames(:)
+    integer, allocatable :: scol(:,:)
+    type(empm_shared_file_t) :: sf
+    call state_columns(model, snames, scol)
+    call h5dont_atexit_f(e)
+    call h5open_f(e)
+    call h5eset_auto_f(0, e)
+    n = size(m)
+    call sf%create(path, model%comm, n, together, tmp, fid, e)
+    if (e /= 0) then
+      oserr = empm_errno()
+      if (sf%together) oserr = model%comm%max_int(oserr)
+      call empm_raise(EMPM_ERR_IO, path//': cannot create the snapshot file '//tmp//': '// &
+        empm_errno_text(oserr), err); return
+    end if
+    ierr = 0
+    call h5_attr(fid, 'format', 'empm snapshot', ierr)
+    call h5_attr(fid, 'time', t, ierr)
+    call h5_attr(fid, 'step', step, ierr)
+    call h5_attr(fid, 'particles', sf%ntotal, ierr)
+    call write_frame(fid, x, x0, v, stress, strain, m, vol, rho, state, mat, snames, scol, &
+      sf%pp, ierr)
+    call sf%close(model%comm, path, tmp, fid, ierr, oserr)
+    if (sf%root) then
+      if (ierr /= 0) then
+        info = empm_remove(tmp)
+      else if (empm_rename(tmp, path) /= 0) then
+        ierr = 1; oserr = empm_errno(); info = empm_remove(tmp)
+      end if
+    end if
+    if (sf%together) then
+      ierr = model%comm%max_int(abs(ierr)); oserr = model%comm%max_int(oserr)
+    end if
+    if (ierr /= 0) call empm_raise(EMPM_ERR_IO, path//': writing the snapshot failed: '// &
+      empm_write_reason(oserr), err)
+  end subroutine empm_write_snapshot_file
+
+  !> The folder that holds a run's snapshots as they are taken, until they are copied into
+  !> the results file `output` at its end: `OUT.h5` -> `OUT.snapshots`.
+  pure function empm_staging_path(output) result(path)
+    character(len=*), intent(in) :: output     !! results file
+    character(len=:), allocatable :: path      !! the folder
+    integer :: n
+    n = len_trim(output)
+    path = output(1:n)
+    if (n > 3) then
+      if (output(n - 2:n) == '.h5') path = output(1:n - 3)
+    end if
+    path = path//'.snapshots'
+  end function empm_staging_path
 
   !> The temporary name a file is written under before it is renamed to `path`: unique to
   !> this process and call (`path.<pid>-<n>.partial`), so that concurrent writers never share

@@ -25,6 +25,15 @@ module empm_history
     integer, allocatable :: id(:)        !! the particles' ids (np): the columns' order
     real(wp), allocatable :: state(:,:)  !! materials' state variables (nstate, np), as
                                          !! `pts%state`
+    ! Only while a snapshot is on its way to a file (empm_run_case), for its XDMF fields:
+    real(wp), allocatable :: x0(:,:)     !! initial positions (ndim, np)
+    integer, allocatable :: mat(:)       !! material indices (np)
+    !> The file the snapshot was written to as it was taken ([[history_add_staged]]), its
+    !> arrays then unallocated; unallocated when the arrays hold it.
+    character(len=:), allocatable :: file
+    !> The group of `file` holding it: '' (the file's root) or a results file's
+    !> `/snapshots/NNNNNN` (a restart's earlier snapshots)
+    character(len=:), allocatable :: frame
   end type empm_snapshot_t
 
   !> Histories of a run.
@@ -57,6 +66,7 @@ module empm_history
     procedure :: init => history_init
     procedure :: add_sample => history_add_sample
     procedure :: add_snapshot => history_add_snapshot
+    procedure :: add_staged => history_add_staged
     procedure :: locate_probes => history_locate_probes
   end type empm_history_t
 
@@ -196,4 +206,19 @@ contains
     self%snap(k)%state = pts%state(:, 1:n)
     self%snap(k)%id = pts%id(1:n)
   end subroutine history_add_snapshot
+
+  !> Record a snapshot that was written to `file` as it was taken (its particle arrays are
+  !> not held: empm_run_case streams them; docs/output.md, "Memory"); ignored beyond the
+  !> reserved count.
+  subroutine history_add_staged(self, t, step, file)
+    class(empm_history_t), intent(inout) :: self !! record
+    real(wp), intent(in) :: t                    !! time [s]
+    integer, intent(in) :: step                  !! step number
+    character(len=*), intent(in) :: file         !! the snapshot's file (at its root)
+    integer :: k
+    if (self%nsnap >= size(self%snap)) return
+    k = self%nsnap + 1; self%nsnap = k
+    self%snap(k)%t = t; self%snap(k)%step = step
+    self%snap(k)%file = file; self%snap(k)%frame = ''
+  end subroutine history_add_staged
 end module empm_history

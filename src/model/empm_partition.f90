@@ -7,6 +7,7 @@ module empm_partition
   use empm_error, only: empm_error_t, empm_raise_error, empm_alloc_error
   use empm_strings, only: str
   use empm_model, only: empm_model_t
+  use empm_comm, only: empm_comm_t
   use empm_particles, only: PARTICLE_FIELDS
   use empm_loads, only: empm_traction_t
   use empm_history, only: empm_history_t, empm_snapshot_t
@@ -14,7 +15,7 @@ module empm_partition
   implicit none
   private
   public :: empm_partition_particles, empm_share_traction_state, empm_gather_particles, empm_rebalance
-  public :: empm_copy_for_output, empm_list_loaded
+  public :: empm_copy_for_output, empm_list_loaded, empm_gather_snapshot
 
 contains
 
@@ -351,6 +352,7 @@ contains
   subroutine keep_snapshot(sn, mine)
     type(empm_snapshot_t), intent(inout) :: sn
     integer, intent(in) :: mine(:)
+    if (allocated(sn%file)) return
     sn%x = sn%x(:, mine); sn%v = sn%v(:, mine)
     sn%stress = sn%stress(:, mine); sn%strain = sn%strain(:, mine)
     sn%m = sn%m(mine); sn%vol = sn%vol(mine); sn%rho = sn%rho(mine)
@@ -434,7 +436,7 @@ contains
       last = 0
     end if
     do k = 1, hist%nsnap
-      call gather_snapshot(hist%snap(k))
+      call empm_gather_snapshot(model%comm, hist%snap(k), by_block)
     end do
     if (by_block) then
       ! Field by field (exchange_fields): a process holds a few copies of one field at a
@@ -472,54 +474,94 @@ contains
 
   contains
 
-    ! The first id's position (0-based) of process r's block; block_start(P) = N.
     integer function block_start(r)
       integer, intent(in) :: r
-      block_start = int((int(r, int64) * ntotal) / model%comm%nranks)
+      block_start = id_block_start(r, ntotal, model%comm%nranks)
     end function block_start
 
-    ! The process whose block holds id i: the r with ⌊rN/P⌋ < i ≤ ⌊(r + 1)N/P⌋.
     integer function owner(i)
       integer, intent(in) :: i
-      owner = int((int(i, int64) * model%comm%nranks - 1) / ntotal)
+      owner = id_block_owner(i, ntotal, model%comm%nranks)
     end function owner
-
-    ! One snapshot's particles (in the order of its ids: the process's particles when it was
-    ! taken), to the root or to the processes of their blocks.
-    subroutine gather_snapshot(sn)
-      type(empm_snapshot_t), intent(inout) :: sn
-      real(wp), allocatable :: r(:,:), a(:,:)
-      integer, allocatable :: ord(:)
-      integer :: mm, q, o, n
-      mm = 1 + 2 * nd + 12 + 3 + ns
-      n = size(sn%id) ! the particles it held then (before a re-cut, perhaps)
-      allocate(r(mm, n))
-      do q = 1, n
-        r(1, q) = real(sn%id(q), wp)
-        r(2:1 + nd, q) = sn%x(:, q); r(2 + nd:1 + 2 * nd, q) = sn%v(:, q)
-        o = 1 + 2 * nd
-        r(o + 1:o + 6, q) = sn%stress(:, q); r(o + 7:o + 12, q) = sn%strain(:, q)
-        r(o + 13, q) = sn%m(q); r(o + 14, q) = sn%vol(q); r(o + 15, q) = sn%rho(q)
-        r(o + 16:o + 15 + ns, q) = sn%state(:, q)
-      end do
-      if (by_block) then
-        call model%comm%exchange_rows(r, n, [(owner(sn%id(q)), q = 1, n)], a)
-      else
-        call model%comm%gather_rows(r, n, a)
-        if (.not. model%comm%is_root()) return
-      end if
-      deallocate(r)
-      ! Particle q of the snapshot is id first + q − 1, in column ord(q) of a.
-      allocate(ord(last - first + 1))
-      do q = 1, size(a, 2)
-        ord(nint(a(1, q)) - first + 1) = q
-      end do
-      o = 1 + 2 * nd
-      sn%x = a(2:1 + nd, ord); sn%v = a(2 + nd:1 + 2 * nd, ord)
-      sn%stress = a(o + 1:o + 6, ord); sn%strain = a(o + 7:o + 12, ord)
-      sn%m = a(o + 13, ord); sn%vol = a(o + 14, ord); sn%rho = a(o + 15, ord)
-      sn%state = a(o + 16:o + 15 + ns, ord)
-      sn%id = [(q, q = first, last)]
-    end subroutine gather_snapshot
   end subroutine empm_gather_particles
+
+  !> One snapshot's particles (its columns in the order of `sn%id`: the process's particles
+  !> when it was taken) to the root in id order, the others then holding none, or with
+  !> `blocks` to the process of each id's block (as [[empm_gather_particles]]). Its `x0` and
+  !> `mat` go along when allocated (on every process alike). Collective; a snapshot held in a
+  !> file (`sn%file`) has nothing to move.
+  subroutine empm_gather_snapshot(comm, sn, blocks)
+    type(empm_comm_t), intent(in) :: comm          !! the run's processes
+    type(empm_snapshot_t), intent(inout) :: sn     !! the snapshot (replaced)
+    logical, intent(in) :: blocks                  !! to the blocks of ids, else to the root
+    real(wp), allocatable :: r(:,:), a(:,:)
+    integer, allocatable :: ord(:)
+    integer :: mm, q, o, n, nd, ns, ntotal, first, last
+    logical :: extra
+    if (allocated(sn%file)) return
+    nd = size(sn%x, 1); ns = size(sn%state, 1)
+    extra = allocated(sn%x0)
+    n = size(sn%id) ! the particles it held then (before a re-cut, perhaps)
+    ntotal = comm%sum_int(n)
+    first = 1; last = ntotal
+    if (blocks) then
+      first = id_block_start(comm%rank, ntotal, comm%nranks) + 1
+      last = id_block_start(comm%rank + 1, ntotal, comm%nranks)
+    else if (.not. comm%is_root()) then
+      last = 0
+    end if
+    mm = 1 + 2 * nd + 12 + 3 + ns
+    if (extra) mm = mm + nd + 1
+    allocate(r(mm, n))
+    o = 1 + 2 * nd
+    do q = 1, n
+      r(1, q) = real(sn%id(q), wp)
+      r(2:1 + nd, q) = sn%x(:, q); r(2 + nd:1 + 2 * nd, q) = sn%v(:, q)
+      r(o + 1:o + 6, q) = sn%stress(:, q); r(o + 7:o + 12, q) = sn%strain(:, q)
+      r(o + 13, q) = sn%m(q); r(o + 14, q) = sn%vol(q); r(o + 15, q) = sn%rho(q)
+      r(o + 16:o + 15 + ns, q) = sn%state(:, q)
+      if (extra) then
+        r(o + 16 + ns:o + 15 + ns + nd, q) = sn%x0(:, q)
+        r(mm, q) = real(sn%mat(q), wp)
+      end if
+    end do
+    if (blocks) then
+      call comm%exchange_rows(r, n, [(id_block_owner(sn%id(q), ntotal, comm%nranks), &
+        q = 1, n)], a)
+    else
+      call comm%gather_rows(r, n, a)
+      ! What another process held went to the root.
+      if (.not. comm%is_root()) then
+        if (allocated(a)) deallocate(a)
+        allocate(a(mm, 0))
+      end if
+    end if
+    deallocate(r)
+    ! Particle q of the snapshot is id first + q − 1, in column ord(q) of a.
+    allocate(ord(max(last - first + 1, 0)))
+    do q = 1, size(a, 2)
+      ord(nint(a(1, q)) - first + 1) = q
+    end do
+    sn%x = a(2:1 + nd, ord); sn%v = a(2 + nd:1 + 2 * nd, ord)
+    sn%stress = a(o + 1:o + 6, ord); sn%strain = a(o + 7:o + 12, ord)
+    sn%m = a(o + 13, ord); sn%vol = a(o + 14, ord); sn%rho = a(o + 15, ord)
+    sn%state = a(o + 16:o + 15 + ns, ord)
+    if (extra) then
+      sn%x0 = a(o + 16 + ns:o + 15 + ns + nd, ord); sn%mat = nint(a(mm, ord))
+    end if
+    sn%id = [(q, q = first, last)]
+  end subroutine empm_gather_snapshot
+
+  ! The first id's position (0-based) of process r's block of ids, of ntotal on nranks
+  ! processes; id_block_start(nranks) = ntotal.
+  pure integer function id_block_start(r, ntotal, nranks)
+    integer, intent(in) :: r, ntotal, nranks
+    id_block_start = int((int(r, int64) * ntotal) / nranks)
+  end function id_block_start
+
+  ! The process whose block holds id i: the r with ⌊rN/P⌋ < i ≤ ⌊(r + 1)N/P⌋.
+  pure integer function id_block_owner(i, ntotal, nranks)
+    integer, intent(in) :: i, ntotal, nranks
+    id_block_owner = int((int(i, int64) * nranks - 1) / ntotal)
+  end function id_block_owner
 end module empm_partition

@@ -56,13 +56,14 @@ module empm_solver
     real(wp) :: work_gravity = 0.0_wp         !! work of a time-varying gravity so far [J]
   end type empm_solver_state_t
 
-  !> What the time loop calls out to, once per step: a checkpoint when one is due, and a
-  !> request to stop (e.g. a signal caught by the program). Extended by the driver, which
-  !> knows where and how to write (the solver writes no files).
+  !> What the time loop calls out to: a checkpoint when one is due, a request to stop (e.g. a
+  !> signal caught by the program), once per step, and each snapshot as it is taken.
+  !> Extended by the driver, which knows where and how to write (the solver writes no files).
   type, abstract :: empm_run_hook_t
   contains
     procedure(hook_checkpoint), deferred :: checkpoint
     procedure :: stop_requested => hook_stop_requested
+    procedure :: snapshot => hook_snapshot
   end type empm_run_hook_t
 
   abstract interface
@@ -121,6 +122,18 @@ contains
     associate (unused_ => self); end associate
     sig = 0
   end function hook_stop_requested
+
+  !> Default: the snapshot is kept in `hist` ([[empm_history_t]]'s `add_snapshot`). Called
+  !> by every process at each snapshot time, after the step that reached it.
+  subroutine hook_snapshot(self, model, hist, err)
+    class(empm_run_hook_t), intent(inout) :: self !! hook
+    type(empm_model_t), intent(in) :: model       !! the state to record
+    type(empm_history_t), intent(inout) :: hist   !! record it goes into
+    type(empm_error_t), intent(out) :: err        !! error (code 0 when recorded)
+    associate (unused_ => self); end associate
+    err%code = 0
+    call hist%add_snapshot(model%t, model%step, model%pts)
+  end subroutine hook_snapshot
 
   !> The run controls of the `&integrator` group (t_end, cfl, dt, max_steps), declared here
   !> where they are used; the case reader reads them, the scheme its own keys.
@@ -283,7 +296,10 @@ contains
       call hist%add_sample(model%t, ekin, estr, egrav, model%pts, model)
       st%t_start = model%t; st%energy_initial = ekin + estr + egrav
       st%dt_min = huge(1.0_wp)
-      call skip_past_snapshots()
+      call skip_past_snapshots(e)
+      if (e%code /= 0) then
+        call empm_raise_error(e, err); return
+      end if
     end if
     show = cfg%progress .and. model%comm%is_root()
     tty = .false.
@@ -387,7 +403,11 @@ contains
         call hist%add_sample(model%t, ekin, estr, egrav, model%pts, model)
       end if
       model%want_energy = .false.
-      call skip_past_snapshots()
+      call skip_past_snapshots(e)
+      if (e%code /= 0) then
+        if (show .and. tty) write(error_unit, '(a)') ''
+        call finish_stats(); call empm_raise_error(e, err); return
+      end if
       if (show) call progress()
       if (present(hook)) then
         ! Every process stops, and checkpoints, at the same step.
@@ -559,10 +579,17 @@ contains
       if (present(stats)) stats = st
     end subroutine finish_stats
 
-    subroutine skip_past_snapshots()
+    ! Record the snapshots whose times the run has reached (the hook's way, else in hist).
+    subroutine skip_past_snapshots(es)
+      type(empm_error_t), intent(out) :: es
       do while (isnap <= nsnap)
         if (cfg%snapshot_times(isnap) > model%t * (1.0_wp + 1.0e-12_wp) + tiny(1.0_wp)) exit
-        call hist%add_snapshot(model%t, model%step, model%pts)
+        if (present(hook)) then
+          call hook%snapshot(model, hist, es)
+          if (es%code /= 0) return
+        else
+          call hist%add_snapshot(model%t, model%step, model%pts)
+        end if
         isnap = isnap + 1
       end do
     end subroutine skip_past_snapshots

@@ -10,6 +10,10 @@
   directory   a folder as -o: refused (status 2), no partial or XDMF file left.
   disk_full   the file-size limit (RLIMIT_FSIZE) below the output size: status 4, one
               message with the system's reason, no HDF5 error stack, no crash, no file left.
+  snapshots   each snapshot goes to OUT.snapshots/ as it is taken: a run's peak memory does
+              not grow with its snapshots (60 against 2 on the same block: the growth is below
+              a tenth of what holding them would cost); the results hold every snapshot and
+              the folder is gone; a snapshot file is there while the run goes on.
   xdmf_fails  the XDMF file cannot be put in place (a folder appears at OUT.xmf during the
               run): status 4 with the system's reason, the XDMF partial removed, the folder
               untouched, the HDF5 file complete.
@@ -169,6 +173,77 @@ def disk_full(empm, cases, work):
         fail(f"left behind: {os.listdir(work)}")
 
 
+SNAP_CASE = """&grid ndim = 2, origin = -0.5, -0.5, h = 0.025, cells = 80, 80 /
+&shape family = 'linear' /
+&material name = 'm', model = 'linear_elastic', E = 1.0e4, nu = 0.3, density = 1.0 /
+&particles material = 'm', geometry = 'box', lo = 0.0, 0.0, hi = 1.0, 1.0, ppc = 2,
+  velocity = 0.1, 0.05 /
+&integrator scheme = 'musl', t_end = {t_end} /
+&output snapshot_times = {times} /
+"""
+
+
+def snapshots(empm, cases, work):
+    import re
+    peaks = {}
+    for n in (2, 60):
+        case = os.path.join(work, f"s{n}.nml")
+        with open(case, "w") as f:
+            f.write(SNAP_CASE.format(t_end=0.02, times=", ".join(
+                f"{0.02 * k / n:.6f}" for k in range(1, n + 1))))
+        out = f"s{n}.h5"
+        p = run(empm, [case, "-o", out], work)
+        if p.returncode != 0:
+            fail(f"{n} snapshots: status {p.returncode}: {p.stderr[-300:]}")
+        m = re.search(r"peak memory ([0-9.]+) MiB", p.stdout + p.stderr)
+        if not m:
+            fail(f"no peak memory on the summary line: {(p.stdout + p.stderr)[-300:]}")
+        peaks[n] = float(m.group(1))
+        with h5py.File(os.path.join(work, out), "r") as f:
+            got, npart = len(f["snapshots"]), f["final/mass"].shape[0]
+            last = f["snapshots"][f"{n:06d}"]["x"][()]
+            if not np.array_equal(last, f["final/x"][()]):
+                fail(f"{n} snapshots: the last one is not the final state")
+        if got != n + 1:
+            fail(f"{n} snapshots asked for (and t = 0): the file holds {got}")
+        if os.path.exists(os.path.join(work, f"s{n}.snapshots")) or leftovers(work):
+            fail(f"left behind: {os.listdir(work)}")
+    held = 60 * npart * (2 * 2 + 15) * 8 / 2**20  # what holding them in memory costs
+    grew = peaks[60] - peaks[2]
+    print(f"{npart} particles: peak {peaks[2]:.1f} MiB with 2 snapshots, {peaks[60]:.1f} MiB "
+          f"with 60 (holding them would add {held:.1f} MiB)")
+    if grew > 0.1 * held:
+        fail(f"the peak memory grew by {grew:.1f} MiB with 58 more snapshots")
+    # While a run goes on, the snapshots taken so far are files of their own.
+    p = start_long_run(empm, cases, work, "live.h5", "snapshot")
+    try:
+        staged = os.path.join(work, "live.snapshots", "000000.h5")
+        deadline = time.time() + 20
+        while not os.path.exists(staged) and time.time() < deadline and p.poll() is None:
+            time.sleep(0.01)
+        if not os.path.exists(staged):
+            if p.poll() is None:
+                fail("no snapshot file while the run went on")
+            print("note: the long run ended before its snapshot file was seen (a fast build)")
+            staged = None
+        try:
+            f = h5py.File(staged, "r") if staged else None
+        except OSError:  # removed as the run ended, the instant after it was seen
+            print("note: the long run ended as its snapshot file was seen (a fast build)")
+            f = None
+        if f:
+            with f:
+                fmt = f.attrs["format"]
+                if (fmt.decode() if isinstance(fmt, bytes) else fmt) != "empm snapshot":
+                    fail(f"the snapshot file's format attribute is {fmt}")
+                print(f"live.snapshots/000000.h5 during the run: t = {f.attrs['time']}, "
+                      f"{f.attrs['particles']} particles")
+    finally:
+        p.communicate(timeout=120)
+    if p.returncode != 0 or os.path.exists(os.path.join(work, "live.snapshots")):
+        fail(f"the long run: status {p.returncode}, left {os.listdir(work)}")
+
+
 def xdmf_fails(empm, cases, work):
     out, xmf = "xf.h5", os.path.join(work, "xf.xmf")
     a = start_long_run(empm, cases, work, out, "the folder could be made")
@@ -199,7 +274,7 @@ def main():
     os.makedirs(work)
     {"concurrent": concurrent, "stale_lock": stale_lock, "fifo": fifo,
      "directory": directory, "disk_full": disk_full,
-     "xdmf_fails": xdmf_fails}[scenario](empm, cases, work)
+     "xdmf_fails": xdmf_fails, "snapshots": snapshots}[scenario](empm, cases, work)
     print("PASS")
 
 

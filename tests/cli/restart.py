@@ -192,7 +192,8 @@ def long_case(work, every=100):
                 .replace("velocity_sine_amplitude = 0.5", "velocity_sine_amplitude = 0.05")
                 .replace("t_end = 3.0", "t_end = 600.0")
                 .replace("checkpoint_every = 40", f"checkpoint_every = {every}")
-                .replace("snapshot_times = 1.0, 2.0", "snapshot_times = 150.0, 300.0"))
+                .replace("snapshot_times = 1.0, 2.0",
+                         "snapshot_times = " + ", ".join(str(50.0 * k) for k in range(1, 12))))
     return case
 
 
@@ -222,7 +223,8 @@ def sigkill(empm, work):
     for trial in range(2):
         for f in os.listdir(work):
             if f.startswith("k.") or f.startswith("k.h5"):
-                os.remove(os.path.join(work, f))
+                path = os.path.join(work, f)
+                shutil.rmtree(path) if os.path.isdir(path) else os.remove(path)
         p = subprocess.Popen([empm, "run", case, "-o", "k.h5"], cwd=work,
                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                              env=dict(os.environ, OMP_NUM_THREADS="1"))
@@ -236,9 +238,16 @@ def sigkill(empm, work):
             step = int(f["model/scalars"][1])
         if step % every != 0:
             fail(f"the checkpoint left is at step {step}, not a multiple of {every}")
-        # A killed run leaves its lock and partial files; the lock of a dead process is taken
-        # over by the restart.
+        # A killed run leaves its lock and partial files, and the snapshots taken so far in
+        # their own files (the restart copies them into its results); the lock of a dead
+        # process is taken over by the restart.
+        staged = os.path.join(work, "k.snapshots")
+        taken = sorted(os.listdir(staged)) if os.path.isdir(staged) else []
+        if not taken or taken[0] != "000000.h5":
+            fail(f"the killed run left no snapshot files in {staged}: {taken}")
         run(empm, [case, "-o", "k.h5", "--restart", ck], work, check=0)
+        if os.path.exists(staged):
+            fail(f"the restarted run left {staged}: {os.listdir(staged)}")
         n, bad = differences(ref, os.path.join(work, "k.h5"))
         print(f"SIGKILL trial {trial}: checkpoint at step {step}; {n} datasets, "
               f"{len(bad)} differ")
@@ -361,6 +370,14 @@ def refuse(empm, work):
             ["not an empm checkpoint"], "results file")
     refused([case, "-o", "o.h5", "--restart", os.path.join(work, "none.h5")],
             ["no such file"], "missing")
+    # The checkpoint names its snapshots: gone from their folder (the run ended) and from the
+    # results, the restart is refused naming both.
+    if os.path.exists(os.path.join(work, "r.snapshots")):
+        fail("the completed run left its snapshot folder r.snapshots")
+    os.rename(os.path.join(work, "r.h5"), os.path.join(work, "r.moved.h5"))
+    refused([case, "-o", "o.h5", "--restart", ck], ["snapshot 0", "r.snapshots/000000.h5",
+                                                     "is missing", "r.h5"], "snapshots lost")
+    os.rename(os.path.join(work, "r.moved.h5"), os.path.join(work, "r.h5"))
     if os.path.exists(os.path.join(work, "o.h5")):
         fail("a refused restart wrote results")
 

@@ -25,6 +25,7 @@ Usage: stops.py EMPM MPIRUN WORKDIR [--ranks 2,3] [--writers all|1]
 """
 import os
 import pathlib
+import re
 import shutil
 import subprocess
 import sys
@@ -217,12 +218,14 @@ def main():
                                           .replace("velocity = 3.0, 0.0", "velocity = 0.3, 0.0"))
     for limited in range(2):
         for f in (work / "C").glob("full*"):
-            f.unlink()
+            shutil.rmtree(f) if f.is_dir() else f.unlink()
         shell = ('if [ "$OMPI_COMM_WORLD_RANK" = ' + str(limited) + ' ]; then trap "" XFSZ; '
                  'ulimit -f 8; fi; exec "$0" run leave.nml -o full.h5')
         rc, log = run(mpi + ["-n", "2", "sh", "-c", shell, empm], work / "C")
         errs = error_lines(log)
-        left = sorted(f.name for f in (work / "C").glob("full*.partial"))
+        # The snapshots go to full.snapshots/ as they are taken: the first write may fail there.
+        left = sorted(f.name for f in (work / "C").glob("full*.partial")) + \
+            sorted(f.name for f in (work / "C").glob("full.snapshots/*.partial"))
         if writers == "1" and limited != 0:
             # Only the root writes: the limited process has nothing to write.
             if rc != 0 or errs or left:
@@ -230,7 +233,7 @@ def main():
             else:
                 print(f"ok   write limited on process {limited} of 2, the root writes: exit 0")
             continue
-        if rc != 4 or len(errs) != 1 or "full.h5" not in errs[0] or left:
+        if rc != 4 or len(errs) != 1 or not re.search(r"full\.(h5|snapshots/)", errs[0]) or left:
             fails.append(f"write failure on process {limited}: exit {rc}, messages {errs}, "
                          f"partial files {left}: {log[-400:]}")
         else:
