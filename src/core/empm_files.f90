@@ -1,13 +1,14 @@
 !> File-system helpers through C interoperability (POSIX rename, remove, mkdir), used to
 !> publish output files atomically and to create output folders.
 module empm_files
-  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char
+  use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_size_t, c_ptr, &
+    c_associated
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_error, only: empm_error_t, EMPM_ERR_IO
   implicit none
   private
   public :: empm_rename, empm_remove, empm_mkdir_p, empm_read_text, empm_physical_memory, &
-            empm_proc_kib, empm_peak_memory
+            empm_proc_kib, empm_peak_memory, empm_rmdir, empm_absolute
 
   interface
     function c_rename(old, new) bind(C, name='rename') result(r)
@@ -20,6 +21,17 @@ module empm_files
       character(kind=c_char), intent(in) :: path(*)
       integer(c_int) :: r
     end function c_remove
+    function c_rmdir(path) bind(C, name='rmdir') result(r)
+      import :: c_int, c_char
+      character(kind=c_char), intent(in) :: path(*)
+      integer(c_int) :: r
+    end function c_rmdir
+    function c_getcwd(buf, size) bind(C, name='getcwd') result(p)
+      import :: c_char, c_size_t, c_ptr
+      character(kind=c_char), intent(out) :: buf(*)
+      integer(c_size_t), value :: size
+      type(c_ptr) :: p
+    end function c_getcwd
     function c_mkdir(path, mode) bind(C, name='mkdir') result(r)
       import :: c_int, c_char
       character(kind=c_char), intent(in) :: path(*)
@@ -42,6 +54,32 @@ contains
     character(len=*), intent(in) :: path !! file to remove
     info = int(c_remove(path//c_null_char))
   end function empm_remove
+
+  !> Remove the folder `path` if it is empty (never a file); returns 0 on success.
+  integer function empm_rmdir(path) result(info)
+    character(len=*), intent(in) :: path !! folder to remove
+    info = int(c_rmdir(path//c_null_char))
+  end function empm_rmdir
+
+  !> `path` made absolute against the working folder (unchanged when it starts with '/', or
+  !> when the working folder cannot be read).
+  function empm_absolute(path) result(abs_path)
+    character(len=*), intent(in) :: path         !! a path
+    character(len=:), allocatable :: abs_path    !! the same place, absolute
+    character(kind=c_char) :: buf(4096)
+    integer :: n
+    abs_path = path
+    if (len(path) > 0) then
+      if (path(1:1) == '/') return
+    end if
+    if (.not. c_associated(c_getcwd(buf, int(size(buf), c_size_t)))) return
+    n = 0
+    do while (n < size(buf))
+      if (buf(n + 1) == c_null_char) exit
+      n = n + 1
+    end do
+    abs_path = transfer(buf(1:n), repeat(' ', n))//'/'//path
+  end function empm_absolute
 
   !> Create folder `path` and its missing parents (like `mkdir -p`); returns 0 when the folder
   !> exists afterwards.

@@ -18,7 +18,7 @@ module empm_checkpoint
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO, EMPM_ERR_INPUT
   use empm_h5, only: h5_group, h5_close_group, h5_write, h5_attr, h5_open_read, &
     h5_close_file, h5_exists, h5_dims, h5_read, h5_read_attr
-  use empm_files, only: empm_rename, empm_remove
+  use empm_files, only: empm_rename, empm_remove, empm_absolute
   use empm_posix, only: empm_errno, empm_errno_text, empm_write_reason, empm_path_kind, &
     PATH_REGULAR
   use empm_version_info, only: empm_version
@@ -493,14 +493,14 @@ contains
           if (ierr /= 0) exit
           sn%frame = trim(fr) ! '' is stored as ' '
           sn%file = resolved(rel)
-          why = snapshot_problem(sn, np)
+          why = snapshot_problem(sn, np, case_text)
           if (len(why) > 0) then
             ! Its own file is gone once the run's results hold it (a run that ended, or was
             ! stopped by a signal): taken from there.
             alt%t = sn%t; alt%step = sn%step; alt%file = resolved(results)
             write(num, '(i6.6)') ks - 1
             alt%frame = '/snapshots/'//num
-            why_alt = snapshot_problem(alt, np)
+            why_alt = snapshot_problem(alt, np, case_text)
             if (len(why_alt) == 0) then
               sn%file = alt%file; sn%frame = alt%frame; why = ''
             else
@@ -523,11 +523,13 @@ contains
 
   ! '' when group `sn%frame` of `sn%file` holds the snapshot `sn` (its time and step) of `np`
   ! particles, else why not (words following "which").
-  function snapshot_problem(sn, np) result(why)
+  function snapshot_problem(sn, np, case_text) result(why)
     use hdf5, only: h5gopen_f, h5gclose_f, hsize_t
     type(empm_snapshot_t), intent(in) :: sn
     integer, intent(in) :: np
+    character(len=*), intent(in) :: case_text
     character(len=:), allocatable :: why
+    character(len=:), allocatable :: text
     integer(hid_t) :: fid, loc
     integer(hsize_t), allocatable :: dims(:)
     integer :: e, step, ie
@@ -540,6 +542,16 @@ contains
     case (2, 3)
       why = 'is not a readable HDF5 file'; return
     end select
+    ! Written for this case (a snapshot file, or the results file): another case's snapshot
+    ! at the same time and step is not this one.
+    call h5_read_attr(fid, 'case_text', text, e)
+    if (e /= 0) then
+      call h5_close_file(fid, ie)
+      why = 'has no case_text attribute'; return
+    else if (text /= case_text) then
+      call h5_close_file(fid, ie)
+      why = 'was written for another case file'; return
+    end if
     loc = fid
     if (len(sn%frame) > 0) call h5gopen_f(fid, sn%frame, loc, e)
     if (e == 0) call h5_read_attr(loc, 'step', step, e)
@@ -561,13 +573,18 @@ contains
     dir = path(1:index(path, '/', back=.true.))
   end function folder_of
 
-  ! `file` relative to the folder `dir` (as folder_of gives it) when it lies there, else as is.
-  pure function relative_to(dir, file) result(rel)
+  ! `file` (a path as the run names it) relative to the folder `dir` (as folder_of gives it):
+  ! the rest of it when it lies there, as it is when `dir` is the working folder, else
+  ! absolute (so that a restart finds it wherever it runs from).
+  function relative_to(dir, file) result(rel)
     character(len=*), intent(in) :: dir, file
     character(len=:), allocatable :: rel
     rel = file
-    if (len(dir) > 0) then
-      if (index(file, dir) == 1) rel = file(len(dir) + 1:)
+    if (len(dir) == 0) return
+    if (index(file, dir) == 1) then
+      rel = file(len(dir) + 1:)
+    else
+      rel = empm_absolute(file)
     end if
   end function relative_to
 

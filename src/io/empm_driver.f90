@@ -11,9 +11,9 @@ module empm_driver
   use empm_solver, only: empm_solve, empm_run_stats_t, empm_run_hook_t, empm_solver_state_t
   use empm_output, only: empm_write_results, empm_output_meta_t, empm_output_claim, &
     empm_output_release, empm_write_snapshot_file, empm_staging_path
-  use empm_files, only: empm_mkdir_p, empm_remove
+  use empm_files, only: empm_mkdir_p, empm_remove, empm_rmdir
   use empm_checkpoint, only: empm_checkpoint_write, empm_checkpoint_read, empm_checkpoint_path
-  use empm_posix, only: empm_stop_signal, empm_sleep
+  use empm_posix, only: empm_stop_signal, empm_sleep, empm_errno, empm_errno_text
   use empm_parallel, only: empm_cpu_sample_t, empm_cpu_sample, empm_threads_for_load, &
                            empm_max_threads, empm_set_threads, EMPM_OMP_MIN_PARTICLES
   use empm_strings, only: str
@@ -32,7 +32,7 @@ module empm_driver
     character(len=:), allocatable :: path       ! OUT.ckpt.h5
     character(len=:), allocatable :: prev       ! OUT.ckpt.prev.h5
     character(len=:), allocatable :: case_text  ! the case file's text
-    character(len=:), allocatable :: staging    ! OUT.snapshots: each snapshot as taken
+    character(len=:), allocatable :: staging    ! OUT.h5.snapshots: each snapshot as taken
     character(len=:), allocatable :: results    ! OUT.h5
   contains
     procedure :: checkpoint => hook_checkpoint
@@ -115,23 +115,19 @@ contains
     if (.not. model%comm%parallel()) then
       ! Straight from the particles.
       associate (p => model%pts)
-        call empm_write_snapshot_file(file, model, model%t, model%step, p%x(:, 1:n), &
-          p%x0(:, 1:n), p%v(:, 1:n), p%stress(:, 1:n), p%strain(:, 1:n), p%m(1:n), &
-          p%vol(1:n), p%rho(1:n), p%state(:, 1:n), p%mat(1:n), .false., err)
+        call empm_write_snapshot_file(file, model%comm, self%case_text, model%t, model%step, &
+          p%x(:, 1:n), &
+          p%v(:, 1:n), p%stress(:, 1:n), p%strain(:, 1:n), p%m(1:n), p%vol(1:n), p%rho(1:n), &
+          p%state(:, 1:n), .false., err)
       end associate
     else
       ! A copy of this process's particles goes to the block of their ids (or the root).
       together = empm_h5_collective(model%comm)
-      associate (p => model%pts)
-        sn%x = p%x(:, 1:n); sn%x0 = p%x0(:, 1:n); sn%v = p%v(:, 1:n)
-        sn%stress = p%stress(:, 1:n); sn%strain = p%strain(:, 1:n)
-        sn%m = p%m(1:n); sn%vol = p%vol(1:n); sn%rho = p%rho(1:n)
-        sn%state = p%state(:, 1:n); sn%mat = p%mat(1:n); sn%id = p%id(1:n)
-      end associate
+      call sn%take(model%t, model%step, model%pts)
       call empm_gather_snapshot(model%comm, sn, together)
       if (together .or. model%comm%is_root()) &
-        call empm_write_snapshot_file(file, model, model%t, model%step, sn%x, sn%x0, sn%v, &
-        sn%stress, sn%strain, sn%m, sn%vol, sn%rho, sn%state, sn%mat, together, err)
+        call empm_write_snapshot_file(file, model%comm, self%case_text, model%t, model%step, &
+        sn%x, sn%v, sn%stress, sn%strain, sn%m, sn%vol, sn%rho, sn%state, together, err)
       call model%comm%agree(err)
     end if
     if (err%code == EMPM_OK) call hist%add_staged(model%t, model%step, file)
@@ -243,9 +239,13 @@ contains
       call empm_output_claim(cs%output_file, e)
       if (e%code == EMPM_OK) then
         if (empm_mkdir_p(hook%staging) /= 0) then
-          call release()
           call e%set(EMPM_ERR_IO, cs%output_file//': cannot create the folder '// &
-            hook%staging//' for its snapshots')
+            hook%staging//' for its snapshots: '//empm_errno_text(empm_errno()))
+          call release()
+        else if (.not. resumed) then
+          ! Snapshots a killed run of this output left (its checkpoint is this run's to
+          ! replace): a fresh run takes none of them.
+          call unstage(.false.)
         end if
       end if
     end if
@@ -302,7 +302,7 @@ contains
       call empm_write_shared(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
     end if
     ! The snapshots are in the results now (a restart takes them from there).
-    if (ew%code == EMPM_OK) call unstage()
+    if (ew%code == EMPM_OK) call unstage(.true.)
     call release()
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then
@@ -323,17 +323,20 @@ contains
 
   contains
 
-    ! The root removes the snapshot files of this run's folder (a killed run's too, which a
-    ! restart names otherwise), and the folder when empty.
-    subroutine unstage()
+    ! The root removes the snapshot files of this run's folder: this run's (some of a
+    ! restarted run's came from its results file instead), then on while they follow each
+    ! other (a run writes them in order: those of an earlier, killed run beyond this one's
+    ! too); with `folder`, the folder when empty.
+    subroutine unstage(folder)
+      logical, intent(in) :: folder
       integer :: k, info
       character(len=6) :: name
       if (.not. cs%model%comm%is_root()) return
-      do k = 1, hist%nsnap
-        write(name, '(i6.6)') k - 1
-        info = empm_remove(hook%staging//'/'//name//'.h5')
+      do k = 0, 999999
+        write(name, '(i6.6)') k
+        if (empm_remove(hook%staging//'/'//name//'.h5') /= 0 .and. k >= hist%nsnap) exit
       end do
-      info = empm_remove(hook%staging)
+      if (folder) info = empm_rmdir(hook%staging)
     end subroutine unstage
 
     ! The root releases the output it claimed (and the snapshot folder, when empty).
@@ -341,7 +344,7 @@ contains
       integer :: info
       if (.not. cs%model%comm%is_root()) return
       call empm_output_release(cs%output_file)
-      if (allocated(hook%staging)) info = empm_remove(hook%staging)
+      if (allocated(hook%staging)) info = empm_rmdir(hook%staging)
     end subroutine release
 
     ! Threads for a run that can use them (EMPM_OMP_MIN_PARTICLES or more): the cores other

@@ -205,7 +205,7 @@ contains
         empm_param('history_every', PARAM_INT, '-', 'sample energies and probes every n steps '// &
           '(and at t_end)', default='1', lo=1.0_wp), &
         empm_param('snapshot_times', PARAM_REAL, 's', 'increasing times in [0, t_end] at '// &
-          'which the particle state is stored (each written to OUT.snapshots/ as it is taken, '// &
+          'which the particle state is stored (each written to OUT.h5.snapshots/ as it is taken, '// &
           'copied into OUT.h5 at the end; docs/output.md)', count=MAXSNAP, lo=0.0_wp, hi=LMAX, &
           optional=.true.), &
         empm_param('checkpoint_every', PARAM_INT, '-', 'write a restart checkpoint every n '// &

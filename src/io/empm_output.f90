@@ -28,7 +28,7 @@ module empm_output
     h5dont_atexit_f
   use empm_kinds, only: wp
   use empm_h5, only: hid_t, h5_group, h5_close_group, h5_write, h5_attr, h5_part_t, &
-    h5_open_read, h5_close_file, h5_read, h5_dims
+    h5_open_read, h5_close_file, h5_read, h5_dims, h5_read_attr
   use hdf5, only: hsize_t
   use empm_h5_mpio, only: empm_h5_collective, h5_mpio_properties, h5_mpio_close
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO, EMPM_ERR_INPUT
@@ -36,10 +36,11 @@ module empm_output
   use empm_posix, only: empm_getpid, empm_process_alive, empm_path_kind, empm_errno, &
     empm_errno_text, empm_write_reason, PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY
   use empm_version_info, only: empm_version
+  use empm_strings, only: str
   use empm_model, only: empm_model_t
   use empm_comm, only: empm_comm_t
   use empm_material, only: STATE_NAME_LEN
-  use empm_history, only: empm_history_t
+  use empm_history, only: empm_history_t, empm_snapshot_t
   use empm_particles, only: empm_particles_t
   implicit none
   private
@@ -102,7 +103,9 @@ contains
     character(len=STATE_NAME_LEN), allocatable :: snames(:)
     integer, allocatable :: scol(:,:)
     type(empm_shared_file_t) :: sf
-    np = model%pts%np
+    type(empm_snapshot_t) :: held
+    integer :: rk, rfail, src
+    np = model%pts%np; rfail = 0
     ierr = 0
     call state_columns(model, snames, scol)
     ! A file whose close failed (its flush: disk full) stays open inside HDF5, and closing it
@@ -168,18 +171,33 @@ contains
       call h5_group(gs, trim(sname), g, ierr)
       call h5_attr(g, 'time', hist%snap(k)%t, ierr)
       call h5_attr(g, 'step', hist%snap(k)%step, ierr)
-      associate (sn => hist%snap(k))
-        if (allocated(sn%file)) then
-          ! Written to its own file as it was taken: copied here, dataset by dataset.
-          call copy_frame(sn%file, sn%frame, g, sf, np, model%grid%ndim, snames, ierr, why)
-        else
-          ! Particles keep their material for the whole run: the current indices apply.
-          n = min(size(sn%m), np)
-          call write_frame(g, sn%x(:, 1:n), model%pts%x0(:, 1:n), sn%v(:, 1:n), &
-            sn%stress(:, 1:n), sn%strain(:, 1:n), sn%m(1:n), sn%vol(1:n), sn%rho(1:n), &
-            sn%state(:, 1:n), model%pts%mat(1:n), snames, scol, sf%pp, ierr)
+      if (allocated(hist%snap(k)%file)) then
+        ! Written to its own file as it was taken: read back (this process's block), then
+        ! written as one held in memory. A snapshot that cannot be read is written as zeros
+        ! by every process (the writes stay collective), and the file then discarded.
+        rk = 0
+        call read_frame(hist%snap(k), sf, np, model%grid%ndim, model%pts%nstate, &
+          model%pts%mat(1:np), snames, scol, held, rk, why)
+        if (sf%together) then
+          ! The reason of the lowest process that failed, for all.
+          src = model%comm%min_int(merge(model%comm%rank, model%comm%nranks, rk /= 0))
+          if (src < model%comm%nranks) then
+            rk = 1
+            if (.not. allocated(why)) why = ''
+            call model%comm%bcast_text(why, src)
+          end if
         end if
-      end associate
+        if (rk /= 0) then
+          rfail = 1; held = empty_frame(model%grid%ndim, model%pts%nstate, np)
+        end if
+      else
+        held = hist%snap(k)
+      end if
+      ! Particles keep their material for the whole run: the current indices apply.
+      n = min(size(held%m), np)
+      call write_frame(g, held%x(:, 1:n), model%pts%x0(:, 1:n), held%v(:, 1:n), &
+        held%stress(:, 1:n), held%strain(:, 1:n), held%m(1:n), held%vol(1:n), held%rho(1:n), &
+        held%state(:, 1:n), model%pts%mat(1:n), snames, scol, sf%pp, ierr)
       call h5_close_group(g, ierr)
     end do
     call h5_close_group(gs, ierr)
@@ -223,12 +241,13 @@ contains
     if (.not. sf%root) return
     if (ierr /= 0) then
       info = empm_remove(tmp)
-      if (len(why) > 0) then
-        call empm_raise(EMPM_ERR_IO, path//': cannot copy a snapshot into it: '//why, err)
-      else
-        call empm_raise(EMPM_ERR_IO, path//': writing the HDF5 output '//tmp//' failed: '// &
-          empm_write_reason(oserr), err)
-      end if
+      call empm_raise(EMPM_ERR_IO, path//': writing the HDF5 output '//tmp//' failed: '// &
+        empm_write_reason(oserr), err)
+      return
+    end if
+    if (rfail /= 0) then
+      info = empm_remove(tmp)
+      call empm_raise(EMPM_ERR_IO, path//': cannot copy a snapshot into it: '//why, err)
       return
     end if
     xmf = empm_xdmf_path(path)
@@ -406,24 +425,30 @@ contains
     call write_xdmf_fields(g, x, x0, v, stress, strain, pp, ierr)
   end subroutine write_frame
 
-  ! Copy the frame datasets of a snapshot (group `frame` of `file`, '' its root) into the
-  ! frame group `g`: this process's columns (sf%first on, np of them), one dataset at a time.
-  ! `why` says what failed when the snapshot cannot be read (ierr set).
-  subroutine copy_frame(file, frame, g, sf, np, nd, snames, ierr, why)
-    character(len=*), intent(in) :: file, frame
-    integer(hid_t), intent(in) :: g
+  ! Read this process's columns (sf%first on, np of them) of a snapshot written as it was
+  ! taken: a snapshot file's raw fields (`x`, `v`, `stress`, `strain`, `mass`, `volume`,
+  ! `density`, `state`: [[empm_write_snapshot_file]]), or, a restart's earlier snapshot, a
+  ! results file's `/snapshots/NNNNNN` group, whose state variables are by name (`mat`, `names`
+  ! and `col` map them back to the materials' rows). `why` says what failed (ierr set).
+  subroutine read_frame(sn, sf, np, nd, ns, mat, names, col, got, ierr, why)
+    type(empm_snapshot_t), intent(in) :: sn
     type(empm_shared_file_t), intent(in) :: sf
-    integer, intent(in) :: np, nd
-    character(len=*), intent(in) :: snames(:)
+    integer, intent(in) :: np, nd, ns, mat(:)
+    character(len=*), intent(in) :: names(:)
+    integer, intent(in) :: col(:,:)
+    type(empm_snapshot_t), intent(out) :: got
     integer, intent(inout) :: ierr
     character(len=:), allocatable, intent(inout) :: why
-    integer(hid_t) :: src, gs
+    integer(hid_t) :: src
     integer(hsize_t), allocatable :: dims(:)
-    integer :: e, k, rs
+    integer :: e, k, p, r, rs, step
     character(len=:), allocatable :: at
-    at = frame
+    real(wp), allocatable :: buf(:)
+    real(wp) :: t(1)
+    at = sn%frame
     if (len(at) > 0) at = at//'/'
-    call h5_open_read(file, src, e)
+    got = empty_frame(nd, ns, np)
+    call h5_open_read(sn%file, src, e)
     if (e == 0) then
       call h5_dims(src, at//'mass', dims, e)
       if (e == 0) then
@@ -433,80 +458,112 @@ contains
           e = 4
         end if
       end if
-      if (e /= 0) call h5_close_file(src, k)
+      ! The snapshot of this run at this time: not one another run left there.
+      if (e == 0) call frame_attrs(src, sn%frame, t, step, e)
+      if (e == 0 .and. (t(1) /= sn%t .or. step /= sn%step)) e = 4
+      if (e /= 0) call h5_close_file(src, rs)
     end if
     if (e /= 0) then
       ierr = 1
       select case (e)
-      case (1); why = file//': no such file (the run wrote it as the snapshot was taken)'
-      case (2, 3); why = file//': not a readable HDF5 file'
-      case default; why = file//': no snapshot of the run''s particles at "'//frame//'"'
+      case (1); why = sn%file//': no such file (the run wrote it as the snapshot was taken)'
+      case (2, 3); why = sn%file//': not a readable HDF5 file'
+      case default; why = sn%file//': not the snapshot of this run at t = '//str(sn%t)// &
+        ' s (step '//itoa(sn%step)//') at "'//sn%frame//'/"'
       end select
       return
     end if
     rs = 0
-    call copy('x', nd, g); call copy('xyz', 3, g); call copy('v', nd, g)
-    call copy('stress', 6, g); call copy('strain', 6, g)
-    call copy('mass', 0, g); call copy('volume', 0, g); call copy('density', 0, g)
-    if (size(snames) > 0) then
-      call h5_group(g, 'state', gs, ierr)
-      do k = 1, size(snames)
-        call copy('state/'//trim(snames(k)), 0, gs, trim(snames(k)))
+    call get2('x', got%x); call get2('v', got%v)
+    call get2('stress', got%stress); call get2('strain', got%strain)
+    call get1('mass', got%m); call get1('volume', got%vol); call get1('density', got%rho)
+    if (len(at) == 0) then
+      if (ns > 0) call get2('state', got%state)
+    else
+      allocate(buf(np))
+      do k = 1, size(names)
+        call get1('state/'//trim(names(k)), buf)
+        do p = 1, np
+          r = 0
+          if (mat(p) >= 1 .and. mat(p) <= size(col, 2)) r = col(k, mat(p))
+          if (r >= 1 .and. r <= ns) got%state(r, p) = buf(p)
+        end do
       end do
-      call h5_close_group(gs, ierr)
     end if
-    call h5_group(g, 'xdmf', gs, ierr)
-    call copy('xdmf/displacement', 3, gs, 'displacement')
-    call copy('xdmf/velocity', 3, gs, 'velocity')
-    call copy('xdmf/stress', 9, gs, 'stress'); call copy('xdmf/strain', 9, gs, 'strain')
-    call h5_close_group(gs, ierr)
     call h5_close_file(src, rs)
     if (rs /= 0) then
       ierr = 1
-      if (len(why) == 0) why = file//': closing it failed'
+      if (len(why) == 0) why = sn%file//': closing it failed'
     end if
   contains
-    ! Dataset `name` of the frame (`rows` rows, 0: rank 1) as `dest` (default: `name`) of `loc`.
-    subroutine copy(name, rows, loc, dest)
+    subroutine get1(name, a)
       character(len=*), intent(in) :: name
-      integer, intent(in) :: rows
-      integer(hid_t), intent(in) :: loc
-      character(len=*), intent(in), optional :: dest
-      real(wp), allocatable :: a1(:), a2(:,:)
-      character(len=:), allocatable :: to
-      integer :: r
-      to = name
-      if (present(dest)) to = dest
-      r = 0
-      if (rows == 0) then
-        allocate(a1(np))
-        call h5_read(src, at//name, a1, r, [sf%first, 1])
-        if (r == 0) call h5_write(loc, to, a1, ierr, sf%pp)
-      else
-        allocate(a2(rows, np))
-        call h5_read(src, at//name, a2, r, [sf%first, 1])
-        if (r == 0) call h5_write(loc, to, a2, ierr, sf%pp)
-      end if
-      if (r /= 0) then
-        ierr = 1
-        if (len(why) == 0) why = file//': cannot read its dataset '//at//name
-      end if
-    end subroutine copy
-  end subroutine copy_frame
+      real(wp), intent(inout) :: a(:)
+      integer :: q
+      q = 0
+      call h5_read(src, at//name, a, q, [sf%first, 1])
+      if (q /= 0) call failed(name)
+    end subroutine get1
+    subroutine get2(name, a)
+      character(len=*), intent(in) :: name
+      real(wp), intent(inout) :: a(:,:)
+      integer :: q
+      q = 0
+      call h5_read(src, at//name, a, q, [sf%first, 1])
+      if (q /= 0) call failed(name)
+    end subroutine get2
+    subroutine failed(name)
+      character(len=*), intent(in) :: name
+      ierr = 1
+      if (len(why) == 0) why = sn%file//': cannot read its dataset '//at//name
+    end subroutine failed
+  end subroutine read_frame
 
-  !> Write one snapshot's frame to its own HDF5 file `path` (atomically: a partial name, then
-  !> renamed), at the root of the file, with the root attributes `format` = 'empm snapshot',
-  !> `time`, `step` and `particles`. Called by every process when `together` (each its block
-  !> of consecutive ids, as [[empm_write_results]]), else by one holding every particle. The
+  ! The `time` and `step` attributes of group `frame` of the open file `fid` ('' its root).
+  subroutine frame_attrs(fid, frame, t, step, e)
+    use hdf5, only: h5gopen_f, h5gclose_f
+    integer(hid_t), intent(in) :: fid
+    character(len=*), intent(in) :: frame
+    real(wp), intent(out) :: t(1)
+    integer, intent(out) :: step, e
+    integer(hid_t) :: loc
+    integer :: ie
+    t = 0.0_wp; step = -1; e = 0
+    loc = fid
+    if (len(frame) > 0) call h5gopen_f(fid, frame, loc, e)
+    if (e /= 0) return
+    call h5_read_attr(loc, 'time', t, e)
+    call h5_read_attr(loc, 'step', step, e)
+    if (loc /= fid) call h5gclose_f(loc, ie)
+  end subroutine frame_attrs
+
+  ! A snapshot of np particles, zero (what is written when reading one failed: the file is
+  ! then removed).
+  function empty_frame(nd, ns, np) result(sn)
+    integer, intent(in) :: nd, ns, np
+    type(empm_snapshot_t) :: sn
+    allocate(sn%x(nd, np), sn%v(nd, np), sn%stress(6, np), sn%strain(6, np), sn%m(np), &
+      sn%vol(np), sn%rho(np), sn%state(ns, np))
+    sn%x = 0.0_wp; sn%v = 0.0_wp; sn%stress = 0.0_wp; sn%strain = 0.0_wp
+    sn%m = 0.0_wp; sn%vol = 0.0_wp; sn%rho = 0.0_wp; sn%state = 0.0_wp
+  end function empty_frame
+
+  !> Write one snapshot to its own HDF5 file `path` (atomically: a partial name, then
+  !> renamed): the root attributes `format` = 'empm snapshot', `time`, `step`, `particles`,
+  !> `case_text` and the raw fields `x` (ndim, np), `v`, `stress` (6, np), `strain`, `mass` (np), `volume`,
+  !> `density` and `state` (the materials' rows, nstate × np; absent when nstate = 0), as h5py
+  !> shows them transposed. Called by every process when `together` (each its block of
+  !> consecutive ids, as [[empm_write_results]]), else by one holding every particle. The
   !> error is every process's.
-  subroutine empm_write_snapshot_file(path, model, t, step, x, x0, v, stress, strain, m, vol, &
-                                      rho, state, mat, together, err)
+  subroutine empm_write_snapshot_file(path, comm, case_text, t, step, x, v, stress, strain, m, &
+                                      vol, rho, state, together, err)
     character(len=*), intent(in) :: path               !! the snapshot's file
-    type(empm_model_t), intent(in) :: model            !! the run (materials, processes)
+    type(empm_comm_t), intent(in) :: comm              !! the run's processes
+    character(len=*), intent(in) :: case_text         !! the case file's text (a restart checks
+                                                       !! that the snapshot is its case's)
     real(wp), intent(in) :: t                          !! its time [s]
     integer, intent(in) :: step                        !! its step
     real(wp), intent(in) :: x(:,:)                     !! positions (ndim, np) [m]
-    real(wp), intent(in) :: x0(:,:)                    !! initial positions (ndim, np) [m]
     real(wp), intent(in) :: v(:,:)                     !! velocities (ndim, np) [m/s]
     real(wp), intent(in) :: stress(:,:)                !! stresses (6, np) [Pa]
     real(wp), intent(in) :: strain(:,:)                !! strains (6, np)
@@ -514,24 +571,19 @@ contains
     real(wp), intent(in) :: vol(:)                     !! volumes (np) [m³]
     real(wp), intent(in) :: rho(:)                     !! densities (np) [kg/m³]
     real(wp), intent(in) :: state(:,:)                 !! state variables (nstate, np)
-    integer, intent(in) :: mat(:)                      !! material indices (np)
     logical, intent(in) :: together                    !! all processes write it (blocks)
     type(empm_error_t), intent(out) :: err             !! error, if any
     integer(hid_t) :: fid
-    integer :: ierr, e, oserr, info, n
+    integer :: ierr, e, oserr, info
     character(len=:), allocatable :: tmp
-    character(len=STATE_NAME_LEN), allocatable :: snames(:)
-    integer, allocatable :: scol(:,:)
     type(empm_shared_file_t) :: sf
-    call state_columns(model, snames, scol)
     call h5dont_atexit_f(e)
     call h5open_f(e)
     call h5eset_auto_f(0, e)
-    n = size(m)
-    call sf%create(path, model%comm, n, together, tmp, fid, e)
+    call sf%create(path, comm, size(m), together, tmp, fid, e)
     if (e /= 0) then
       oserr = empm_errno()
-      if (sf%together) oserr = model%comm%max_int(oserr)
+      if (sf%together) oserr = comm%max_int(oserr)
       call empm_raise(EMPM_ERR_IO, path//': cannot create the snapshot file '//tmp//': '// &
         empm_errno_text(oserr), err); return
     end if
@@ -540,9 +592,16 @@ contains
     call h5_attr(fid, 'time', t, ierr)
     call h5_attr(fid, 'step', step, ierr)
     call h5_attr(fid, 'particles', sf%ntotal, ierr)
-    call write_frame(fid, x, x0, v, stress, strain, m, vol, rho, state, mat, snames, scol, &
-      sf%pp, ierr)
-    call sf%close(model%comm, path, tmp, fid, ierr, oserr)
+    call h5_attr(fid, 'case_text', case_text, ierr)
+    call h5_write(fid, 'x', x, ierr, sf%pp)
+    call h5_write(fid, 'v', v, ierr, sf%pp)
+    call h5_write(fid, 'stress', stress, ierr, sf%pp)
+    call h5_write(fid, 'strain', strain, ierr, sf%pp)
+    call h5_write(fid, 'mass', m, ierr, sf%pp)
+    call h5_write(fid, 'volume', vol, ierr, sf%pp)
+    call h5_write(fid, 'density', rho, ierr, sf%pp)
+    if (size(state, 1) > 0) call h5_write(fid, 'state', state, ierr, sf%pp)
+    call sf%close(comm, path, tmp, fid, ierr, oserr)
     if (sf%root) then
       if (ierr /= 0) then
         info = empm_remove(tmp)
@@ -551,24 +610,19 @@ contains
       end if
     end if
     if (sf%together) then
-      ierr = model%comm%max_int(abs(ierr)); oserr = model%comm%max_int(oserr)
+      ierr = comm%max_int(abs(ierr)); oserr = comm%max_int(oserr)
     end if
     if (ierr /= 0) call empm_raise(EMPM_ERR_IO, path//': writing the snapshot failed: '// &
       empm_write_reason(oserr), err)
   end subroutine empm_write_snapshot_file
 
   !> The folder that holds a run's snapshots as they are taken, until they are copied into
-  !> the results file `output` at its end: `OUT.h5` -> `OUT.snapshots`.
+  !> the results file `output` at its end: `OUT.h5` -> `OUT.h5.snapshots` (the whole name, as
+  !> the output's lock: two outputs never share one).
   pure function empm_staging_path(output) result(path)
     character(len=*), intent(in) :: output     !! results file
     character(len=:), allocatable :: path      !! the folder
-    integer :: n
-    n = len_trim(output)
-    path = output(1:n)
-    if (n > 3) then
-      if (output(n - 2:n) == '.h5') path = output(1:n - 3)
-    end if
-    path = path//'.snapshots'
+    path = trim(output)//'.snapshots'
   end function empm_staging_path
 
   !> The temporary name a file is written under before it is renamed to `path`: unique to
@@ -607,6 +661,12 @@ contains
     if (empm_path_kind(xmf) /= PATH_MISSING .and. empm_path_kind(xmf) /= PATH_REGULAR) then
       call err%set(EMPM_ERR_INPUT, path//': its XDMF file '//xmf// &
         ' exists and is not a regular file; refusing to replace it'); return
+    end if
+    if (empm_path_kind(empm_staging_path(path)) /= PATH_MISSING .and. &
+        empm_path_kind(empm_staging_path(path)) /= PATH_DIRECTORY) then
+      call err%set(EMPM_ERR_INPUT, path//': '//empm_staging_path(path)//', where its '// &
+        'snapshots go as they are taken, exists and is not a folder; refusing to replace it')
+      return
     end if
     lock = path//'.lock'
     do attempt = 1, 2

@@ -25,15 +25,14 @@ module empm_history
     integer, allocatable :: id(:)        !! the particles' ids (np): the columns' order
     real(wp), allocatable :: state(:,:)  !! materials' state variables (nstate, np), as
                                          !! `pts%state`
-    ! Only while a snapshot is on its way to a file (empm_run_case), for its XDMF fields:
-    real(wp), allocatable :: x0(:,:)     !! initial positions (ndim, np)
-    integer, allocatable :: mat(:)       !! material indices (np)
     !> The file the snapshot was written to as it was taken ([[history_add_staged]]), its
     !> arrays then unallocated; unallocated when the arrays hold it.
     character(len=:), allocatable :: file
     !> The group of `file` holding it: '' (the file's root) or a results file's
     !> `/snapshots/NNNNNN` (a restart's earlier snapshots)
     character(len=:), allocatable :: frame
+  contains
+    procedure :: take => snapshot_take
   end type empm_snapshot_t
 
   !> Histories of a run.
@@ -196,16 +195,28 @@ contains
     real(wp), intent(in) :: t                    !! time [s]
     integer, intent(in) :: step                  !! step number
     type(empm_particles_t), intent(in) :: pts    !! particles
-    integer :: k, n
     if (self%nsnap >= size(self%snap)) return
-    k = self%nsnap + 1; self%nsnap = k; n = pts%np
-    self%snap(k)%t = t; self%snap(k)%step = step
-    self%snap(k)%x = pts%x(:, 1:n); self%snap(k)%v = pts%v(:, 1:n)
-    self%snap(k)%stress = pts%stress(:, 1:n); self%snap(k)%strain = pts%strain(:, 1:n)
-    self%snap(k)%m = pts%m(1:n); self%snap(k)%vol = pts%vol(1:n); self%snap(k)%rho = pts%rho(1:n)
-    self%snap(k)%state = pts%state(:, 1:n)
-    self%snap(k)%id = pts%id(1:n)
+    self%nsnap = self%nsnap + 1
+    call self%snap(self%nsnap)%take(t, step, pts)
   end subroutine history_add_snapshot
+
+  !> The particles' state as a snapshot (a copy of their arrays, in their order, with ids).
+  subroutine snapshot_take(self, t, step, pts)
+    class(empm_snapshot_t), intent(inout) :: self !! snapshot (replaced)
+    real(wp), intent(in) :: t                     !! time [s]
+    integer, intent(in) :: step                   !! step number
+    type(empm_particles_t), intent(in) :: pts     !! particles
+    integer :: n
+    n = pts%np
+    self%t = t; self%step = step
+    self%x = pts%x(:, 1:n); self%v = pts%v(:, 1:n)
+    self%stress = pts%stress(:, 1:n); self%strain = pts%strain(:, 1:n)
+    self%m = pts%m(1:n); self%vol = pts%vol(1:n); self%rho = pts%rho(1:n)
+    self%state = pts%state(:, 1:n)
+    self%id = pts%id(1:n)
+    if (allocated(self%file)) deallocate(self%file)
+    if (allocated(self%frame)) deallocate(self%frame)
+  end subroutine snapshot_take
 
   !> Record a snapshot that was written to `file` as it was taken (its particle arrays are
   !> not held: empm_run_case streams them; docs/output.md, "Memory"); ignored beyond the

@@ -487,9 +487,8 @@ contains
 
   !> One snapshot's particles (its columns in the order of `sn%id`: the process's particles
   !> when it was taken) to the root in id order, the others then holding none, or with
-  !> `blocks` to the process of each id's block (as [[empm_gather_particles]]). Its `x0` and
-  !> `mat` go along when allocated (on every process alike). Collective; a snapshot held in a
-  !> file (`sn%file`) has nothing to move.
+  !> `blocks` to the process of each id's block (as [[empm_gather_particles]]). Collective; a
+  !> snapshot held in a file (`sn%file`) has nothing to move.
   subroutine empm_gather_snapshot(comm, sn, blocks)
     type(empm_comm_t), intent(in) :: comm          !! the run's processes
     type(empm_snapshot_t), intent(inout) :: sn     !! the snapshot (replaced)
@@ -497,10 +496,8 @@ contains
     real(wp), allocatable :: r(:,:), a(:,:)
     integer, allocatable :: ord(:)
     integer :: mm, q, o, n, nd, ns, ntotal, first, last
-    logical :: extra
     if (allocated(sn%file)) return
     nd = size(sn%x, 1); ns = size(sn%state, 1)
-    extra = allocated(sn%x0)
     n = size(sn%id) ! the particles it held then (before a re-cut, perhaps)
     ntotal = comm%sum_int(n)
     first = 1; last = ntotal
@@ -511,7 +508,6 @@ contains
       last = 0
     end if
     mm = 1 + 2 * nd + 12 + 3 + ns
-    if (extra) mm = mm + nd + 1
     allocate(r(mm, n))
     o = 1 + 2 * nd
     do q = 1, n
@@ -520,10 +516,6 @@ contains
       r(o + 1:o + 6, q) = sn%stress(:, q); r(o + 7:o + 12, q) = sn%strain(:, q)
       r(o + 13, q) = sn%m(q); r(o + 14, q) = sn%vol(q); r(o + 15, q) = sn%rho(q)
       r(o + 16:o + 15 + ns, q) = sn%state(:, q)
-      if (extra) then
-        r(o + 16 + ns:o + 15 + ns + nd, q) = sn%x0(:, q)
-        r(mm, q) = real(sn%mat(q), wp)
-      end if
     end do
     if (blocks) then
       call comm%exchange_rows(r, n, [(id_block_owner(sn%id(q), ntotal, comm%nranks), &
@@ -546,9 +538,6 @@ contains
     sn%stress = a(o + 1:o + 6, ord); sn%strain = a(o + 7:o + 12, ord)
     sn%m = a(o + 13, ord); sn%vol = a(o + 14, ord); sn%rho = a(o + 15, ord)
     sn%state = a(o + 16:o + 15 + ns, ord)
-    if (extra) then
-      sn%x0 = a(o + 16 + ns:o + 15 + ns + nd, ord); sn%mat = nint(a(mm, ord))
-    end if
     sn%id = [(q, q = first, last)]
   end subroutine empm_gather_snapshot
 

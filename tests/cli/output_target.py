@@ -10,7 +10,7 @@
   directory   a folder as -o: refused (status 2), no partial or XDMF file left.
   disk_full   the file-size limit (RLIMIT_FSIZE) below the output size: status 4, one
               message with the system's reason, no HDF5 error stack, no crash, no file left.
-  snapshots   each snapshot goes to OUT.snapshots/ as it is taken: a run's peak memory does
+  snapshots   each snapshot goes to OUT.h5.snapshots/ as it is taken: a run's peak memory does
               not grow with its snapshots (60 against 2 on the same block: the growth is below
               a tenth of what holding them would cost); the results hold every snapshot and
               the folder is gone; a snapshot file is there while the run goes on.
@@ -206,7 +206,7 @@ def snapshots(empm, cases, work):
                 fail(f"{n} snapshots: the last one is not the final state")
         if got != n + 1:
             fail(f"{n} snapshots asked for (and t = 0): the file holds {got}")
-        if os.path.exists(os.path.join(work, f"s{n}.snapshots")) or leftovers(work):
+        if os.path.exists(os.path.join(work, f"s{n}.h5.snapshots")) or leftovers(work):
             fail(f"left behind: {os.listdir(work)}")
     held = 60 * npart * (2 * 2 + 15) * 8 / 2**20  # what holding them in memory costs
     grew = peaks[60] - peaks[2]
@@ -214,10 +214,18 @@ def snapshots(empm, cases, work):
           f"with 60 (holding them would add {held:.1f} MiB)")
     if grew > 0.1 * held:
         fail(f"the peak memory grew by {grew:.1f} MiB with 58 more snapshots")
+    # A file where the snapshot folder goes is refused (status 2), left as it was.
+    with open(os.path.join(work, "f.h5.snapshots"), "w") as fh:
+        fh.write("precious\n")
+    p = run(empm, [os.path.join(work, "s2.nml"), "-o", "f.h5"], work)
+    if p.returncode != 2 or "f.h5.snapshots" not in p.stderr or \
+            open(os.path.join(work, "f.h5.snapshots")).read() != "precious\n":
+        fail(f"a file at the snapshot folder's place: status {p.returncode}: {p.stderr[-300:]}")
+    print(f"a file at f.h5.snapshots: status 2: {p.stderr.strip()[:120]}")
     # While a run goes on, the snapshots taken so far are files of their own.
     p = start_long_run(empm, cases, work, "live.h5", "snapshot")
     try:
-        staged = os.path.join(work, "live.snapshots", "000000.h5")
+        staged = os.path.join(work, "live.h5.snapshots", "000000.h5")
         deadline = time.time() + 20
         while not os.path.exists(staged) and time.time() < deadline and p.poll() is None:
             time.sleep(0.01)
@@ -236,11 +244,11 @@ def snapshots(empm, cases, work):
                 fmt = f.attrs["format"]
                 if (fmt.decode() if isinstance(fmt, bytes) else fmt) != "empm snapshot":
                     fail(f"the snapshot file's format attribute is {fmt}")
-                print(f"live.snapshots/000000.h5 during the run: t = {f.attrs['time']}, "
+                print(f"live.h5.snapshots/000000.h5 during the run: t = {f.attrs['time']}, "
                       f"{f.attrs['particles']} particles")
     finally:
         p.communicate(timeout=120)
-    if p.returncode != 0 or os.path.exists(os.path.join(work, "live.snapshots")):
+    if p.returncode != 0 or os.path.exists(os.path.join(work, "live.h5.snapshots")):
         fail(f"the long run: status {p.returncode}, left {os.listdir(work)}")
 
 

@@ -241,7 +241,7 @@ def sigkill(empm, work):
         # A killed run leaves its lock and partial files, and the snapshots taken so far in
         # their own files (the restart copies them into its results); the lock of a dead
         # process is taken over by the restart.
-        staged = os.path.join(work, "k.snapshots")
+        staged = os.path.join(work, "k.h5.snapshots")
         taken = sorted(os.listdir(staged)) if os.path.isdir(staged) else []
         if not taken or taken[0] != "000000.h5":
             fail(f"the killed run left no snapshot files in {staged}: {taken}")
@@ -372,12 +372,18 @@ def refuse(empm, work):
             ["no such file"], "missing")
     # The checkpoint names its snapshots: gone from their folder (the run ended) and from the
     # results, the restart is refused naming both.
-    if os.path.exists(os.path.join(work, "r.snapshots")):
-        fail("the completed run left its snapshot folder r.snapshots")
+    if os.path.exists(os.path.join(work, "r.h5.snapshots")):
+        fail("the completed run left its snapshot folder r.h5.snapshots")
     os.rename(os.path.join(work, "r.h5"), os.path.join(work, "r.moved.h5"))
-    refused([case, "-o", "o.h5", "--restart", ck], ["snapshot 0", "r.snapshots/000000.h5",
+    refused([case, "-o", "o.h5", "--restart", ck], ["snapshot 0", "r.h5.snapshots/000000.h5",
                                                      "is missing", "r.h5"], "snapshots lost")
     os.rename(os.path.join(work, "r.moved.h5"), os.path.join(work, "r.h5"))
+    # Another case run on the same output since: its snapshots are not this case's.
+    keep = os.path.join(work, "r.keep.ckpt.h5")
+    shutil.copy(ck, keep)
+    run(empm, [other, "-o", "r.h5"], work, check=0)
+    refused([case, "-o", "o.h5", "--restart", keep], ["snapshot 0", "another case file"],
+            "snapshots of another case")
     if os.path.exists(os.path.join(work, "o.h5")):
         fail("a refused restart wrote results")
 

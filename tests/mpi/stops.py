@@ -223,9 +223,9 @@ def main():
                  'ulimit -f 8; fi; exec "$0" run leave.nml -o full.h5')
         rc, log = run(mpi + ["-n", "2", "sh", "-c", shell, empm], work / "C")
         errs = error_lines(log)
-        # The snapshots go to full.snapshots/ as they are taken: the first write may fail there.
+        # The snapshots go to full.h5.snapshots/ as they are taken: the first write may fail there.
         left = sorted(f.name for f in (work / "C").glob("full*.partial")) + \
-            sorted(f.name for f in (work / "C").glob("full.snapshots/*.partial"))
+            sorted(f.name for f in (work / "C").glob("full.h5.snapshots/*.partial"))
         if writers == "1" and limited != 0:
             # Only the root writes: the limited process has nothing to write.
             if rc != 0 or errs or left:
