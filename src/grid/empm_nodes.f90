@@ -72,6 +72,9 @@ module empm_nodes
                                                     !! [[nodes_compute_reactions]]
     type(node_catalogue_t), private :: cat          !! set-up's constraints in whole-grid
                                                     !! numbering (windows only)
+    logical, private :: sparse = .false.            !! a parallel run's set-up: the fixed dofs
+                                                    !! kept in the catalogue only, no array
+                                                    !! of the whole grid's nodes
   contains
     procedure :: alloc => nodes_alloc
     procedure :: reset => nodes_reset
@@ -124,6 +127,7 @@ contains
     call move2(self%work)
     self%nnode = n
     deallocate(self%fixed, self%vfix, self%mirrored)
+    self%sparse = .false.
     allocate(self%fixed(nd, n), self%vfix(nd, n), self%mirrored(n))
     self%fixed = .false.; self%vfix = 0.0_wp; self%mirrored = .false.
     do k = 1, size(self%cat%fix)
@@ -215,8 +219,10 @@ contains
     type(empm_grid_t), intent(in) :: whole
     if (any(whole%off /= 0) .or. any(whole%ln /= whole%nn)) &
       error stop 'empm_nodes: the first window must be taken from the whole grid'
-    self%cat%fix = self%fixed_dofs
-    self%cat%vfix = pack(self%vfix, self%fixed)
+    if (.not. self%sparse) then
+      self%cat%fix = self%fixed_dofs
+      self%cat%vfix = pack(self%vfix, self%fixed)
+    end if
     self%cat%set_ptr = self%set_ptr; self%cat%set_dof = self%set_dof
     self%cat%ghost = self%ghost(1:self%nmirror); self%cat%image = self%image(1:self%nmirror)
     self%cat%msign = self%msign(:, 1:self%nmirror)
@@ -226,36 +232,41 @@ contains
 
   !> Allocate nodal storage for `grid`; no dof fixed. An allocation failure is reported in
   !> `err` when present (with the memory asked for), otherwise it stops the program. With
-  !> `fields = .false.` only the constraints are stored (the boundaries can be set) and the
-  !> fields are empty until a window is taken ([[nodes_window]]): a parallel run's set-up,
-  !> which never holds the whole grid's fields.
+  !> `fields = .false.` (a parallel run's set-up, which never holds the whole grid's fields)
+  !> nothing node-sized is stored: the fields are empty and the constraints, which can be
+  !> set, are lists of the fixed dofs (a boundary's worth) until a window is taken
+  !> ([[nodes_window]]).
   subroutine nodes_alloc(self, grid, err, fields)
     class(empm_nodes_t), intent(inout) :: self     !! nodal fields
     type(empm_grid_t), intent(in) :: grid          !! background grid
     type(empm_error_t), intent(inout), optional :: err !! set on an allocation failure
     logical, intent(in), optional :: fields        !! allocate the fields (default .true.)
-    integer :: d, n, nf, stat
+    integer :: d, n, nf, nc, stat
     character(len=256) :: msg
     d = grid%ndim; n = grid%nnode
     nf = n
     if (present(fields)) then
       if (.not. fields) nf = 0
     end if
+    self%sparse = nf == 0 .and. n > 0
+    nc = nf ! node-sized constraint arrays
     self%ndim = d; self%nnode = n
     if (allocated(self%mass)) deallocate(self%mass, self%mom, self%vel, self%force, self%acc, &
       self%work, self%fixed, self%vfix, self%vol)
     allocate(self%mass(nf), self%mom(d, nf), self%vel(d, nf), self%force(d, nf), &
-      self%acc(d, nf), self%work(d, nf), self%fixed(d, n), self%vfix(d, n), self%vol(nf), &
+      self%acc(d, nf), self%work(d, nf), self%fixed(d, nc), self%vfix(d, nc), self%vol(nf), &
       stat=stat, errmsg=msg)
     if (stat /= 0) then
       self%nnode = 0
       call empm_raise_error(empm_alloc_error('nodal fields ('//str(n)//' nodes)', &
-        int(nf, int64) * 8_int64 * (2 + 5 * d) + int(n, int64) * 12_int64 * d, msg), err)
+        int(nf, int64) * 8_int64 * (2 + 5 * d) + int(nc, int64) * 12_int64 * d, msg), err)
       return
     end if
     self%fixed = .false.; self%vfix = 0.0_wp
-    call self%list_fixed()
     self%cat%made = .false.
+    if (allocated(self%cat%fix)) deallocate(self%cat%fix, self%cat%vfix)
+    allocate(self%cat%fix(0), self%cat%vfix(0))
+    call self%list_fixed()
     self%nset = 0
     if (allocated(self%set_name)) deallocate(self%set_name, self%set_ptr, self%set_dof, &
       self%set_fix, self%set_vel, self%reaction)
@@ -272,7 +283,7 @@ contains
                                           self%plane_at)
     allocate(self%ghost(0), self%image(0), self%msign(d, 0), self%plane_side(0), self%plane_at(0))
     if (allocated(self%mirrored)) deallocate(self%mirrored)
-    allocate(self%mirrored(n))
+    allocate(self%mirrored(nc))
     self%mirrored = .false.
   end subroutine nodes_alloc
 
@@ -293,8 +304,8 @@ contains
     integer, intent(out) :: nsel               !! plane nodes selected
     integer, intent(out) :: info               !! status (above)
     real(wp) :: tol, zero3(3)
-    integer :: a, id, k, ijk(3), g(3), m(3), ip, nd, d, ng
-    integer, allocatable :: gh(:), im(:)
+    integer :: a, id, k, ijk(3), g(3), m(3), ip, nd, d, ng, q
+    integer, allocatable :: gh(:), im(:), sel(:)
     real(wp), allocatable :: sg(:,:)
     info = 0; nd = grid%ndim; a = abs(side); zero3 = 0.0_wp
     tol = 1.0e-9_wp * grid%hmin()
@@ -308,15 +319,16 @@ contains
     end if
     allocate(gh(0), im(0), sg(nd, 0))
     ng = 0
-    do id = 1, grid%nnode
-      if (.not. in_box(grid, id, lo, hi, tol)) cycle
+    call box_nodes(grid, lo, hi, tol, sel)
+    do q = 1, size(sel)
+      id = sel(q)
       ijk = grid%node_ijk(id)
       do k = 1, grid%nn(a)
         g = ijk; g(a) = ijk(a) + sign(k, side)
         m = ijk; m(a) = ijk(a) - sign(k, side)
         if (g(a) < 0 .or. g(a) > grid%nn(a) - 1 .or. m(a) < 0 .or. m(a) > grid%nn(a) - 1) exit
-        if (any(self%fixed(:, grid%node_id(g))) .or. any(gh == grid%node_id(g)) .or. &
-            any(self%ghost == grid%node_id(g))) then
+        if (any([(self%is_fixed(d, grid%node_id(g)), d = 1, nd)]) .or. &
+            any(gh == grid%node_id(g)) .or. any(self%ghost == grid%node_id(g))) then
           info = 3; return
         end if
         gh = [gh, grid%node_id(g)]; im = [im, grid%node_id(m)]
@@ -330,7 +342,7 @@ contains
     self%ghost = [self%ghost, gh]; self%image = [self%image, im]
     self%msign = reshape([self%msign, sg], [nd, size(self%ghost)])
     self%nmirror = size(self%ghost)
-    self%mirrored(im) = .true.
+    if (.not. self%sparse) self%mirrored(im) = .true. ! a window marks its own
     self%plane_side = [self%plane_side, side]; self%plane_at = [self%plane_at, lo(a)]
     self%nplane = size(self%plane_side)
   end subroutine nodes_mirror_box
@@ -441,25 +453,30 @@ contains
     integer, intent(out) :: nsel               !! number of nodes selected
     character(len=*), intent(in), optional :: name !! name of the reaction set to record
     real(wp) :: tol
-    integer :: id, d, nd
-    integer, allocatable :: dofs(:)
+    integer :: q, id, d, nd, nc, j
+    integer, allocatable :: ids(:), dofs(:)
+    real(wp), allocatable :: vals(:)
     if (.not. allocated(self%mass) .or. self%nnode /= grid%nnode) call self%alloc(grid)
     ! A node counts as inside when within a small fraction of a cell of the box.
     tol = 1.0e-9_wp * grid%hmin()
-    nsel = 0; nd = grid%ndim
-    allocate(dofs(0))
-    do id = 1, grid%nnode
-      if (in_box(grid, id, lo, hi, tol)) then
-        nsel = nsel + 1
-        do d = 1, grid%ndim
-          if (comp(d)) then
+    nd = grid%ndim
+    call box_nodes(grid, lo, hi, tol, ids)
+    nsel = size(ids); nc = count(comp(1:nd))
+    allocate(dofs(nsel * nc), vals(nsel * nc))
+    j = 0
+    do q = 1, nsel
+      id = ids(q)
+      do d = 1, nd
+        if (comp(d)) then
+          j = j + 1; dofs(j) = d + nd * (id - 1); vals(j) = value(d)
+          if (.not. self%sparse) then
             self%fixed(d, id) = .true.
             self%vfix(d, id) = value(d)
-            if (present(name)) dofs = [dofs, d + nd * (id - 1)]
           end if
-        end do
-      end if
+        end if
+      end do
     end do
+    if (self%sparse) call merge_fixed(self%cat, dofs, vals)
     call self%list_fixed()
     if (present(name)) call add_set(self, name, dofs, comp(1:nd), value(1:nd))
   end subroutine nodes_fix_box
@@ -490,7 +507,7 @@ contains
     if (hi(a) - lo(a) > tol) then
       info = 1; return
     end if
-    ids = pack([(id, id = 1, grid%nnode)], [(in_box(grid, id, lo, hi, tol), id = 1, grid%nnode)])
+    call box_nodes(grid, lo, hi, tol, ids)
     if (size(ids) == 0) info = 2
     do id = 1, size(ids)
       if (self%fric%has(ids(id))) info = 3
@@ -538,6 +555,88 @@ contains
     in_box = all(xi(1:grid%ndim) >= lo(1:grid%ndim) - tol .and. &
                  xi(1:grid%ndim) <= hi(1:grid%ndim) + tol)
   end function in_box
+
+  ! The nodes in the closed box [lo, hi] within `tol`, in increasing order: those of the
+  ! box's index range (a node wider on each side, against rounding), each checked by in_box.
+  subroutine box_nodes(grid, lo, hi, tol, ids)
+    type(empm_grid_t), intent(in) :: grid
+    real(wp), intent(in) :: lo(3), hi(3), tol
+    integer, allocatable, intent(out) :: ids(:)
+    integer, allocatable :: found(:)
+    integer :: a(3), b(3), d, i, j, k, n, id
+    a = 0; b = 0
+    do d = 1, grid%ndim
+      a(d) = first_index((lo(d) - tol - grid%origin(d)) * grid%inv_h(d)) - 1
+      b(d) = first_index((hi(d) + tol - grid%origin(d)) * grid%inv_h(d)) + 1
+      a(d) = max(a(d), 0); b(d) = min(b(d), grid%nn(d) - 1)
+    end do
+    n = 0
+    if (all(a <= b)) n = product(b - a + 1)
+    allocate(found(n))
+    n = 0
+    do k = a(3), b(3)
+      do j = a(2), b(2)
+        do i = a(1), b(1)
+          id = grid%node_id([i, j, k])
+          if (id == 0) cycle
+          if (.not. in_box(grid, id, lo, hi, tol)) cycle
+          n = n + 1; found(n) = id
+        end do
+      end do
+    end do
+    allocate(ids(n))
+    ids = found(1:n)
+  contains
+    ! floor(r), clamped to the grid's index range (a box far outside, or infinite, too).
+    integer function first_index(r)
+      real(wp), intent(in) :: r
+      first_index = int(floor(min(max(r, -2.0_wp), real(grid%nn(d) + 1, wp))))
+    end function first_index
+  end subroutine box_nodes
+
+  ! Add the dofs `dofs` (increasing) with velocities `vals` to the catalogue's sorted list;
+  ! a dof already there takes the new value (as a later box overwrites an earlier one).
+  subroutine merge_fixed(cat, dofs, vals)
+    type(node_catalogue_t), intent(inout) :: cat
+    integer, intent(in) :: dofs(:)
+    real(wp), intent(in) :: vals(:)
+    integer, allocatable :: f(:)
+    real(wp), allocatable :: v(:)
+    integer :: i, j, n
+    allocate(f(size(cat%fix) + size(dofs)), v(size(cat%fix) + size(dofs)))
+    i = 1; j = 1; n = 0
+    do while (i <= size(cat%fix) .or. j <= size(dofs))
+      n = n + 1
+      if (j > size(dofs)) then
+        f(n) = cat%fix(i); v(n) = cat%vfix(i); i = i + 1
+      else if (i > size(cat%fix)) then
+        f(n) = dofs(j); v(n) = vals(j); j = j + 1
+      else if (cat%fix(i) < dofs(j)) then
+        f(n) = cat%fix(i); v(n) = cat%vfix(i); i = i + 1
+      else
+        if (cat%fix(i) == dofs(j)) i = i + 1
+        f(n) = dofs(j); v(n) = vals(j); j = j + 1
+      end if
+    end do
+    cat%fix = f(1:n); cat%vfix = v(1:n)
+  end subroutine merge_fixed
+
+  ! Position of `dof` in the increasing list `list` (0: absent), by bisection.
+  pure integer function listed(list, dof) result(k)
+    integer, intent(in) :: list(:), dof
+    integer :: lo, hi, mid
+    k = 0; lo = 1; hi = size(list)
+    do while (lo <= hi)
+      mid = (lo + hi) / 2
+      if (list(mid) == dof) then
+        k = mid; return
+      else if (list(mid) < dof) then
+        lo = mid + 1
+      else
+        hi = mid - 1
+      end if
+    end do
+  end function listed
 
   !> Append the reaction set `name` (set-up only).
   subroutine add_set(self, name, dofs, comp, value)
@@ -622,6 +721,9 @@ contains
     class(empm_nodes_t), intent(inout) :: self !! nodal fields
     integer :: k
     if (allocated(self%fixed_dofs)) deallocate(self%fixed_dofs)
+    if (self%sparse) then
+      self%fixed_dofs = self%cat%fix; return
+    end if
     if (.not. allocated(self%fixed)) then
       allocate(self%fixed_dofs(0)); return
     end if
@@ -636,8 +738,12 @@ contains
     integer, intent(in) :: d                   !! component, 1..ndim
     integer, intent(in) :: id                  !! node, 1..nnode
     real(wp), intent(in) :: value              !! prescribed velocity [m/s]
-    self%fixed(d, id) = .true.
-    self%vfix(d, id) = value
+    if (self%sparse) then
+      call merge_fixed(self%cat, [d + self%ndim * (id - 1)], [value])
+    else
+      self%fixed(d, id) = .true.
+      self%vfix(d, id) = value
+    end if
     call self%list_fixed()
   end subroutine nodes_fix_dof
 
@@ -646,7 +752,11 @@ contains
     class(empm_nodes_t), intent(in) :: self !! nodal fields
     integer, intent(in) :: d                !! component
     integer, intent(in) :: id               !! node
-    nodes_is_fixed = self%fixed(d, id)
+    if (self%sparse) then
+      nodes_is_fixed = listed(self%cat%fix, d + self%ndim * (id - 1)) > 0
+    else
+      nodes_is_fixed = self%fixed(d, id)
+    end if
   end function nodes_is_fixed
 
   !> Prescribed velocity of component `d` of node `id` (0 when free) [m/s].
@@ -654,7 +764,14 @@ contains
     class(empm_nodes_t), intent(in) :: self !! nodal fields
     integer, intent(in) :: d                !! component
     integer, intent(in) :: id               !! node
-    nodes_fixed_velocity = merge(self%vfix(d, id), 0.0_wp, self%fixed(d, id))
+    integer :: k
+    if (self%sparse) then
+      k = listed(self%cat%fix, d + self%ndim * (id - 1))
+      nodes_fixed_velocity = 0.0_wp
+      if (k > 0) nodes_fixed_velocity = self%cat%vfix(k)
+    else
+      nodes_fixed_velocity = merge(self%vfix(d, id), 0.0_wp, self%fixed(d, id))
+    end if
   end function nodes_fixed_velocity
 
   !> Number of prescribed dofs.
