@@ -4,11 +4,14 @@
 !>
 !> A malformed file is an input error (EMPM_ERR_INPUT) whose message names the file and the
 !> line (for CSV also the column; for HDF5 the dataset and the point).
+!>
+!> Shared among processes, each keeps every `stride`-th point only (`keep`): a CSV file is
+!> read line by line and an HDF5 one in blocks of points, every point checked on every
+!> process (the same error everywhere), so that no process holds the whole list.
 module empm_bodies
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, EMPM_ERR_INPUT, EMPM_OK
-  use empm_files, only: empm_read_text
   use empm_strings, only: str, lower
   use empm_gmsh, only: empm_gmsh_points, empm_text_to_real
   use empm_h5, only: hid_t, h5_open_read, h5_close_file, h5_exists, h5_dims, h5_read
@@ -19,7 +22,8 @@ module empm_bodies
 
   !> The points of one body, before they become particles.
   type :: empm_body_points_t
-    integer :: n = 0                          !! points
+    integer :: n = 0                          !! points kept (all, unless `keep`)
+    integer :: total = 0                      !! points in the file
     real(wp), allocatable :: x(:,:)           !! positions (ndim, n) [m]
     real(wp), allocatable :: vol(:)           !! volumes (n) [m^ndim]
     logical :: has_velocity = .false.         !! the file gives velocities
@@ -53,20 +57,29 @@ contains
 
   !> Read the body in `path` (format from the extension) for an `ndim`-dimensional case.
   !> `order` is the quadrature order per direction for a mesh (the case's `ppc`).
-  subroutine empm_read_body(path, ndim, order, body, err)
+  subroutine empm_read_body(path, ndim, order, body, err, keep)
     character(len=*), intent(in) :: path               !! .csv, .h5/.hdf5 or .msh file
     integer, intent(in) :: ndim                        !! spatial dimension (1..3)
     integer, intent(in) :: order                       !! mesh quadrature order (1..4)
     type(empm_body_points_t), intent(out) :: body      !! the points
     type(empm_error_t), intent(inout) :: err           !! set on a malformed file
+    integer, intent(in), optional :: keep(2)           !! (first, stride): keep points
+                                                       !! first + 1, first + 1 + stride, ...
+                                                       !! only (first 0-based); default all
+    integer :: kp(2)
+    kp = [0, 1]
+    if (present(keep)) kp = keep
     select case (extension(path))
     case ('csv')
-      call read_csv(path, ndim, body, err)
+      call read_csv(path, ndim, kp, body, err)
     case ('h5', 'hdf5')
-      call read_hdf5(path, ndim, body, err)
+      call read_hdf5(path, ndim, kp, body, err)
     case ('msh')
+      ! A mesh's quadrature points are made whole, then kept.
       call empm_gmsh_points(path, ndim, order, body%x, body%vol, err)
       if (err%code /= EMPM_OK) return
+      body%total = size(body%vol)
+      body%x = body%x(:, kp(1) + 1::kp(2)); body%vol = body%vol(kp(1) + 1::kp(2))
       body%n = size(body%vol)
       allocate(body%v(ndim, body%n), body%stress(6, body%n))
       body%v = 0.0_wp; body%stress = 0.0_wp
@@ -89,30 +102,30 @@ contains
 
   !> A header line naming the columns, then one point per line; blank lines and lines
   !> starting with '#' are skipped.
-  subroutine read_csv(path, ndim, body, err)
+  subroutine read_csv(path, ndim, keep, body, err)
     character(len=*), intent(in) :: path
-    integer, intent(in) :: ndim
+    integer, intent(in) :: ndim, keep(2)
     type(empm_body_points_t), intent(inout) :: body
     type(empm_error_t), intent(inout) :: err
-    type(empm_error_t) :: e
-    character(len=:), allocatable :: text, ln
+    character(len=:), allocatable :: ln
     character(len=256), allocatable :: fld(:)
+    character(len=512) :: msg
     integer, allocatable :: col(:)        ! column -> index into COLS
-    real(wp), allocatable :: val(:,:)     ! (13, capacity)
-    real(wp) :: r
-    integer :: b, i, lnum, nf, ncol, k, c, n, hline
+    real(wp), allocatable :: val(:,:)     ! (13, capacity): the points kept
+    real(wp) :: r, row(13)
+    integer :: u, ios, lnum, nf, ncol, k, c, n, total, hline
     logical :: header_done, big, ok
-    call empm_read_text(path, text, e)
-    if (e%code /= EMPM_OK) then
-      call err%set(EMPM_ERR_INPUT, 'cannot read the point list: '//e%message, file=path); return
+    ! Line by line: the text is never held whole.
+    open(newunit=u, file=path, status='old', action='read', form='formatted', &
+         access='sequential', iostat=ios, iomsg=msg)
+    if (ios /= 0) then
+      call err%set(EMPM_ERR_INPUT, 'cannot read the point list: '//trim(msg), file=path); return
     end if
-    header_done = .false.; n = 0; lnum = 0; b = 1; ncol = 0; hline = 0
+    header_done = .false.; n = 0; total = 0; lnum = 0; ncol = 0; hline = 0
     allocate(val(13, 256))
-    do while (b <= len(text))
-      i = index(text(b:), new_line('a'))
-      if (i == 0) i = len(text) - b + 2
-      ln = text(b:b + i - 2)
-      b = b + i
+    do
+      call get_line(u, ln, ios)
+      if (ios /= 0) exit
       lnum = lnum + 1
       if (len(ln) > 0) then
         if (ln(len(ln):len(ln)) == achar(13)) ln = ln(1:len(ln) - 1)
@@ -123,51 +136,66 @@ contains
       if (.not. header_done) then
         hline = lnum
         call header(fld(1:nf))
-        if (err%code /= EMPM_OK) return
+        if (err%code /= EMPM_OK) then
+          close(u); return
+        end if
         header_done = .true.; ncol = nf
         cycle
       end if
       if (nf /= ncol) then
         call err%set(EMPM_ERR_INPUT, 'expected '//str(ncol)//' comma-separated values (as '// &
-          'the header at line '//str(hline)//'), got '//str(nf), file=path, line=lnum); return
+          'the header at line '//str(hline)//'), got '//str(nf), file=path, line=lnum)
+        close(u); return
       end if
-      if (n == size(val, 2)) val = reshape(val, [13, 2 * n], pad=[0.0_wp])
-      n = n + 1
-      val(:, n) = 0.0_wp
+      row = 0.0_wp
       do k = 1, nf
         c = col(k)
         ok = empm_text_to_real(fld(k), r, big)
         if (big) r = huge(r)  ! reported as beyond the magnitude bound below
         if (.not. (ok .or. big)) then
           call err%set(EMPM_ERR_INPUT, 'column '//str(k)//' ('''//trim(COLS(c))// &
-            '''): expected a number, got '''//trim(fld(k))//'''', file=path, line=lnum); return
+            '''): expected a number, got '''//trim(fld(k))//'''', file=path, line=lnum)
+          close(u); return
         end if
         if (abs(r) > merge(SMAX, merge(XMAX**ndim, XMAX, c == 4), c >= 8)) then
           call err%set(EMPM_ERR_INPUT, 'column '//str(k)//' ('''//trim(COLS(c))// &
             '''): '//trim(fld(k))//' is beyond the accepted magnitude ('// &
             trim(merge('1e15 m or m/s; volume 1e15^ndim', '1e30 Pa                        ', &
-            c < 8))//')', file=path, line=lnum); return
+            c < 8))//')', file=path, line=lnum)
+          close(u); return
         end if
         if (c == 4 .and. r <= 0.0_wp) then
           call err%set(EMPM_ERR_INPUT, 'column '//str(k)//' (''volume''): expected a '// &
-            'volume > 0, got '//trim(fld(k)), file=path, line=lnum); return
+            'volume > 0, got '//trim(fld(k)), file=path, line=lnum)
+          close(u); return
         end if
         if (beyond(c, ndim) .and. r /= 0.0_wp) then
           call err%set(EMPM_ERR_INPUT, 'column '//str(k)//' ('''//trim(COLS(c))// &
             '''): must be 0 in a '//str(ndim)//'-D case, got '//trim(fld(k)), file=path, &
-            line=lnum); return
+            line=lnum)
+          close(u); return
         end if
-        val(c, n) = r
+        row(c) = r
       end do
+      total = total + 1
+      if (total - 1 < keep(1) .or. mod(total - 1 - keep(1), keep(2)) /= 0) cycle
+      if (n == size(val, 2)) val = reshape(val, [13, 2 * n], pad=[0.0_wp])
+      n = n + 1
+      val(:, n) = row
     end do
+    close(u)
+    if (ios > 0) then
+      call err%set(EMPM_ERR_INPUT, 'cannot read the point list after line '//str(lnum), &
+        file=path); return
+    end if
     if (.not. header_done) then
       call err%set(EMPM_ERR_INPUT, 'empty point list: expected a header line naming the '// &
         'columns (x, y, z, volume, ...)', file=path); return
     end if
-    if (n == 0) then
+    if (total == 0) then
       call err%set(EMPM_ERR_INPUT, 'no point after the header', file=path, line=hline); return
     end if
-    body%n = n
+    body%n = n; body%total = total
     body%x = val(1:ndim, 1:n)
     body%vol = val(4, 1:n)
     body%v = val(5:4 + ndim, 1:n)
@@ -212,6 +240,24 @@ contains
         join_names(COLS(1:ndim))//', volume)', file=path, line=lnum)
     end subroutine header
   end subroutine read_csv
+
+  ! The next line of unit u (any length), without its end; ios < 0 at the end of the file.
+  subroutine get_line(u, ln, ios)
+    integer, intent(in) :: u
+    character(len=:), allocatable, intent(out) :: ln
+    integer, intent(out) :: ios
+    character(len=4096) :: buf
+    integer :: got
+    ln = ''
+    do
+      read(u, '(a)', advance='no', iostat=ios, size=got) buf
+      ln = ln//buf(1:got)
+      if (ios /= 0) exit
+    end do
+    ! The end of a line is a whole line; so is a last line without a newline.
+    if (is_iostat_eor(ios)) ios = 0
+    if (is_iostat_end(ios) .and. len(ln) > 0) ios = 0
+  end subroutine get_line
 
   !> Columns for directions beyond ndim (z in 2D, vy in 1D, ...): accepted when 0.
   pure logical function beyond(c, ndim)
@@ -266,14 +312,17 @@ contains
 
   !> Datasets /x (ndim, n), /volume (n), optional /v (ndim, n) and /stress (6, n), in
   !> Fortran order (written from C or Python: shapes (n, ndim), (n), (n, ndim), (n, 6)).
-  subroutine read_hdf5(path, ndim, body, err)
+  subroutine read_hdf5(path, ndim, keep, body, err)
     character(len=*), intent(in) :: path
-    integer, intent(in) :: ndim
+    integer, intent(in) :: ndim, keep(2)
     type(empm_body_points_t), intent(inout) :: body
     type(empm_error_t), intent(inout) :: err
+    ! Points read at a time: every one is checked, those kept are stored.
+    integer, parameter :: BLOCK = 65536
     integer(hid_t) :: fid
-    integer :: ierr, n, q
+    integer :: ierr, n, q, q0, m, j, kept
     integer(hsize_t), allocatable :: dims(:)
+    real(wp), allocatable :: x(:,:), vol(:), v(:,:), st(:,:)
     call h5_open_read(path, fid, ierr)
     if (ierr /= 0) then
       call err%set(EMPM_ERR_INPUT, trim(merge('cannot open: no such file     ', &
@@ -284,46 +333,57 @@ contains
     n = 0
     call dataset_dims('volume', 1, 0, n)
     if (err%code /= EMPM_OK) go to 9
-    allocate(body%x(ndim, n), body%vol(n), body%v(ndim, n), body%stress(6, n))
-    body%n = n; body%v = 0.0_wp; body%stress = 0.0_wp
     call dataset_dims('x', 2, ndim, n)
     if (err%code /= EMPM_OK) go to 9
-    ierr = 0
-    call h5_read(fid, 'volume', body%vol, ierr)
-    call h5_read(fid, 'x', body%x, ierr)
     body%has_velocity = h5_exists(fid, 'v')
-    if (body%has_velocity) then
-      call dataset_dims('v', 2, ndim, n)
-      if (err%code /= EMPM_OK) go to 9
-      call h5_read(fid, 'v', body%v, ierr)
-    end if
+    if (body%has_velocity) call dataset_dims('v', 2, ndim, n)
+    if (err%code /= EMPM_OK) go to 9
     body%has_stress = h5_exists(fid, 'stress')
-    if (body%has_stress) then
-      call dataset_dims('stress', 2, 6, n)
-      if (err%code /= EMPM_OK) go to 9
-      call h5_read(fid, 'stress', body%stress, ierr)
+    if (body%has_stress) call dataset_dims('stress', 2, 6, n)
+    if (err%code /= EMPM_OK) go to 9
+    if (n == 0) then
+      call err%set(EMPM_ERR_INPUT, 'dataset /volume holds no point', file=path); go to 9
     end if
-    if (ierr /= 0) then
-      call err%set(EMPM_ERR_INPUT, 'cannot read the datasets', file=path); go to 9
-    end if
-    do q = 1, n
-      if (.not. all(ieee_is_finite(body%x(:, q))) .or. .not. ieee_is_finite(body%vol(q)) .or. &
-          .not. all(ieee_is_finite(body%v(:, q))) .or. &
-          .not. all(ieee_is_finite(body%stress(:, q)))) then
-        call err%set(EMPM_ERR_INPUT, 'point '//str(q)//': a value is not finite', file=path)
-        go to 9
+    body%total = n
+    kept = 0
+    if (n > keep(1)) kept = (n - 1 - keep(1)) / keep(2) + 1
+    allocate(body%x(ndim, kept), body%vol(kept), body%v(ndim, kept), body%stress(6, kept))
+    body%n = kept; body%v = 0.0_wp; body%stress = 0.0_wp
+    allocate(x(ndim, min(n, BLOCK)), vol(min(n, BLOCK)), v(ndim, min(n, BLOCK)), &
+      st(6, min(n, BLOCK)))
+    v = 0.0_wp; st = 0.0_wp
+    ierr = 0
+    do q0 = 0, n - 1, BLOCK
+      m = min(BLOCK, n - q0)
+      call h5_read(fid, 'volume', vol(1:m), ierr, [q0, 1])
+      call h5_read(fid, 'x', x(:, 1:m), ierr, [q0, 1])
+      if (body%has_velocity) call h5_read(fid, 'v', v(:, 1:m), ierr, [q0, 1])
+      if (body%has_stress) call h5_read(fid, 'stress', st(:, 1:m), ierr, [q0, 1])
+      if (ierr /= 0) then
+        call err%set(EMPM_ERR_INPUT, 'cannot read the datasets', file=path); go to 9
       end if
-      if (any(abs(body%x(:, q)) > XMAX) .or. any(abs(body%v(:, q)) > XMAX) .or. &
-          body%vol(q) > XMAX**ndim .or. any(abs(body%stress(:, q)) > SMAX)) then
-        call err%set(EMPM_ERR_INPUT, 'point '//str(q)//': a value is beyond the accepted '// &
-          'magnitude (1e15 m or m/s, volume 1e15^ndim, 1e30 Pa)', file=path); go to 9
-      end if
-      if (body%vol(q) <= 0.0_wp) then
-        call err%set(EMPM_ERR_INPUT, 'dataset /volume, point '//str(q)//': expected a '// &
-          'volume > 0, got '//str(body%vol(q)), file=path); go to 9
-      end if
+      do j = 1, m
+        q = q0 + j
+        if (.not. all(ieee_is_finite(x(:, j))) .or. .not. ieee_is_finite(vol(j)) .or. &
+            .not. all(ieee_is_finite(v(:, j))) .or. .not. all(ieee_is_finite(st(:, j)))) then
+          call err%set(EMPM_ERR_INPUT, 'point '//str(q)//': a value is not finite', file=path)
+          go to 9
+        end if
+        if (any(abs(x(:, j)) > XMAX) .or. any(abs(v(:, j)) > XMAX) .or. &
+            vol(j) > XMAX**ndim .or. any(abs(st(:, j)) > SMAX)) then
+          call err%set(EMPM_ERR_INPUT, 'point '//str(q)//': a value is beyond the accepted '// &
+            'magnitude (1e15 m or m/s, volume 1e15^ndim, 1e30 Pa)', file=path); go to 9
+        end if
+        if (vol(j) <= 0.0_wp) then
+          call err%set(EMPM_ERR_INPUT, 'dataset /volume, point '//str(q)//': expected a '// &
+            'volume > 0, got '//str(vol(j)), file=path); go to 9
+        end if
+        if (q - 1 < keep(1) .or. mod(q - 1 - keep(1), keep(2)) /= 0) cycle
+        kept = (q - 1 - keep(1)) / keep(2) + 1
+        body%x(:, kept) = x(:, j); body%vol(kept) = vol(j)
+        body%v(:, kept) = v(:, j); body%stress(:, kept) = st(:, j)
+      end do
     end do
-    if (n == 0) call err%set(EMPM_ERR_INPUT, 'dataset /volume holds no point', file=path)
 9   call h5_close_file(fid, ierr)
 
   contains

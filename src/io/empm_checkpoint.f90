@@ -411,20 +411,9 @@ contains
     end subroutine open_group
 
     integer function int_attr(name) result(v)
-      use hdf5, only: h5aopen_f, h5aread_f, h5aclose_f, H5T_NATIVE_INTEGER, hsize_t
       character(len=*), intent(in) :: name
-      integer(hid_t) :: aid
-      integer(hsize_t) :: dims(1)
-      integer :: buf(1), ie
-      v = -1; dims = 1
-      call h5aopen_f(fid, name, aid, ie)
-      if (ie /= 0) then
-        ierr = 1; return
-      end if
-      call h5aread_f(aid, H5T_NATIVE_INTEGER, buf, dims, ie)
-      if (ie /= 0) ierr = 1
-      v = buf(1)
-      call h5aclose_f(aid, ie)
+      v = -1
+      call h5_read_attr(fid, name, v, ierr)
     end function int_attr
 
     ! The histories as recorded up to the checkpoint, in arrays with room to grow.
@@ -495,12 +484,19 @@ contains
           sn%file = resolved(rel)
           why = snapshot_problem(sn, np, case_text)
           if (len(why) > 0) then
-            ! Its own file is gone once the run's results hold it (a run that ended, or was
-            ! stopped by a signal): taken from there.
-            alt%t = sn%t; alt%step = sn%step; alt%file = resolved(results)
+            ! Its own file is gone once the results of the run that took it hold it (a run
+            ! that ended, or was stopped by a signal): taken from there, the results beside
+            ! the snapshot's folder (OUT.h5 of OUT.h5.snapshots/), else this checkpoint's.
+            alt%t = sn%t; alt%step = sn%step
             write(num, '(i6.6)') ks - 1
             alt%frame = '/snapshots/'//num
-            why_alt = snapshot_problem(alt, np, case_text)
+            alt%file = results_of(sn%file)
+            why_alt = 'is not named'
+            if (len(alt%file) > 0) why_alt = snapshot_problem(alt, np, case_text)
+            if (len(why_alt) > 0 .and. alt%file /= resolved(results)) then
+              alt%file = resolved(results)
+              why_alt = snapshot_problem(alt, np, case_text)
+            end if
             if (len(why_alt) == 0) then
               sn%file = alt%file; sn%frame = alt%frame; why = ''
             else
@@ -565,6 +561,18 @@ contains
       why = 'holds another (step '//str(step)//', t = '//str(t(1))//' s)'
     end if
   end function snapshot_problem
+
+  ! The results file whose snapshot folder holds `file` (OUT.h5 for OUT.h5.snapshots/NNNNNN.h5),
+  ! '' when `file` lies in no such folder (a results file itself).
+  pure function results_of(file) result(res)
+    character(len=*), intent(in) :: file
+    character(len=:), allocatable :: res
+    character(len=*), parameter :: TAIL = '.snapshots/'
+    integer :: k
+    res = ''
+    k = index(file, TAIL, back=.true.)
+    if (k > 1) res = file(1:k - 1)
+  end function results_of
 
   ! The folder part of `path`, with its final '/' ('' for a bare name).
   pure function folder_of(path) result(dir)

@@ -242,10 +242,6 @@ contains
           call e%set(EMPM_ERR_IO, cs%output_file//': cannot create the folder '// &
             hook%staging//' for its snapshots: '//empm_errno_text(empm_errno()))
           call release()
-        else if (.not. resumed) then
-          ! Snapshots a killed run of this output left (its checkpoint is this run's to
-          ! replace): a fresh run takes none of them.
-          call unstage(.false.)
         end if
       end if
     end if
@@ -302,7 +298,7 @@ contains
       call empm_write_shared(cs%output_file, cs%model, hist, meta, .false., e%message, ew)
     end if
     ! The snapshots are in the results now (a restart takes them from there).
-    if (ew%code == EMPM_OK) call unstage(.true.)
+    if (ew%code == EMPM_OK) call unstage()
     call release()
     if (present(written)) written = cs%output_file
     if (e%code /= EMPM_OK) then
@@ -326,9 +322,8 @@ contains
     ! The root removes the snapshot files of this run's folder: this run's (some of a
     ! restarted run's came from its results file instead), then on while they follow each
     ! other (a run writes them in order: those of an earlier, killed run beyond this one's
-    ! too); with `folder`, the folder when empty.
-    subroutine unstage(folder)
-      logical, intent(in) :: folder
+    ! too), and the folder when empty.
+    subroutine unstage()
       integer :: k, info
       character(len=6) :: name
       if (.not. cs%model%comm%is_root()) return
@@ -336,7 +331,7 @@ contains
         write(name, '(i6.6)') k
         if (empm_remove(hook%staging//'/'//name//'.h5') /= 0 .and. k >= hist%nsnap) exit
       end do
-      if (folder) info = empm_rmdir(hook%staging)
+      info = empm_rmdir(hook%staging)
     end subroutine unstage
 
     ! The root releases the output it claimed (and the snapshot folder, when empty).

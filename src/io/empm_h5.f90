@@ -386,17 +386,9 @@ contains
     integer(hid_t) :: aid, tid
     integer(size_t) :: n
     integer(hsize_t) :: dims(1)
-    logical :: there
     integer :: e
     s = ''
-    call h5aexists_f(loc, name, there, e)
-    if (e /= 0 .or. .not. there) then
-      ierr = 1; return
-    end if
-    call h5aopen_f(loc, name, aid, e)
-    if (e /= 0) then
-      ierr = 1; return
-    end if
+    if (.not. open_attr(loc, name, aid, ierr)) return
     call h5aget_type_f(aid, tid, e)
     if (e == 0) call h5tget_size_f(tid, n, e)
     if (e == 0 .and. n > 0 .and. n < 100000000_size_t) then
@@ -420,16 +412,8 @@ contains
     integer(hid_t) :: aid
     integer(hsize_t) :: dims(1)
     integer :: buf(1), e
-    logical :: there
     i = 0; dims = 1
-    call h5aexists_f(loc, name, there, e)
-    if (e /= 0 .or. .not. there) then
-      ierr = 1; return
-    end if
-    call h5aopen_f(loc, name, aid, e)
-    if (e /= 0) then
-      ierr = 1; return
-    end if
+    if (.not. open_attr(loc, name, aid, ierr)) return
     call h5aread_f(aid, H5T_NATIVE_INTEGER, buf, dims, e)
     if (e /= 0) ierr = 1
     i = buf(1)
@@ -446,8 +430,23 @@ contains
     integer(hid_t) :: aid
     integer(hsize_t) :: dims(1)
     integer :: e
-    logical :: there
     x = 0.0_wp; dims = size(x, kind=hsize_t)
+    if (.not. open_attr(loc, name, aid, ierr)) return
+    call h5aread_f(aid, H5T_NATIVE_DOUBLE, x, dims, e)
+    if (e /= 0) ierr = 1
+    call h5aclose_f(aid, e)
+  end subroutine read_attr_r
+
+  ! Open the attribute `name` of `loc` as `aid` (the caller closes it); false, with ierr set,
+  ! when it is missing or cannot be opened (HDF5 then prints nothing: it is checked first).
+  logical function open_attr(loc, name, aid, ierr) result(ok)
+    integer(hid_t), intent(in) :: loc
+    character(len=*), intent(in) :: name
+    integer(hid_t), intent(out) :: aid
+    integer, intent(inout) :: ierr
+    logical :: there
+    integer :: e
+    ok = .false.; aid = -1
     call h5aexists_f(loc, name, there, e)
     if (e /= 0 .or. .not. there) then
       ierr = 1; return
@@ -456,9 +455,7 @@ contains
     if (e /= 0) then
       ierr = 1; return
     end if
-    call h5aread_f(aid, H5T_NATIVE_DOUBLE, x, dims, e)
-    if (e /= 0) ierr = 1
-    call h5aclose_f(aid, e)
-  end subroutine read_attr_r
+    ok = .true.
+  end function open_attr
 
 end module empm_h5

@@ -687,7 +687,7 @@ contains
         'center', 'radius', 'placement']
       character(len=:), allocatable :: full
       real(wp) :: lp(3)
-      integer :: j, id
+      integer :: j, k, id
       logical :: mine
       if (.not. g%has('file') .or. len_trim(file) == 0) then
         call g%fail(e, 'file', 'required for geometry = ''file'': a point list (.csv, .h5) '// &
@@ -700,7 +700,10 @@ contains
         end if
       end do
       full = empm_body_path(path, file)
-      call empm_read_body(full, nd, ppc, body, e)
+      ! Shared, this process keeps the points dealt to it only: those whose ids (the next
+      ! ones, in the file's order) are its own.
+      call empm_read_body(full, nd, ppc, body, e, keep=[modulo(cs%deal%rank - cs%deal%n, &
+        cs%deal%every), cs%deal%every])
       if (e%code /= EMPM_OK) then
         ! The file's own location first, then the group that asked for it.
         e%message = e%message//' (&particles body '//str(nbody)//', '//path//':'// &
@@ -716,24 +719,26 @@ contains
         call g%fail(e, 'stress', 'the file '''//file//''' gives stresses: give them there '// &
           'or with the stress key, not both (body '//str(nbody)//')'); return
       end if
-      do j = 1, body%n
+      k = 0
+      do j = 1, body%total
         call cs%deal%next(id, mine)
         if (.not. mine) cycle
+        k = k + 1 ! the kept point of this id
         ! uGIMP half-lengths: half the side of the cube (square, segment) of the volume.
         lp = 0.0_wp
-        lp(1:nd) = 0.5_wp * body%vol(j)**(1.0_wp / nd)
-        call cs%model%pts%append(body%x(:, j), body%vol(j), cs%model%mats(imat)%model%rho0, &
+        lp(1:nd) = 0.5_wp * body%vol(k)**(1.0_wp / nd)
+        call cs%model%pts%append(body%x(:, k), body%vol(k), cs%model%mats(imat)%model%rho0, &
           lp(1:nd), imat, e, id=id)
         if (e%code /= EMPM_OK) return
         q = cs%model%pts%np
         if (body%has_velocity) then
-          cs%model%pts%v(:, q) = body%v(:, j)
+          cs%model%pts%v(:, q) = body%v(:, k)
         else
           cs%model%pts%v(:, q) = velocity(1:nd) + amp(1:nd) * &
-            sin(sum(wavenumber(1:nd) * body%x(:, j)) + phase)
+            sin(sum(wavenumber(1:nd) * body%x(:, k)) + phase)
         end if
         if (body%has_stress) then
-          cs%model%pts%stress(:, q) = body%stress(:, j)
+          cs%model%pts%stress(:, q) = body%stress(:, k)
         else
           cs%model%pts%stress(:, q) = stress
         end if

@@ -493,52 +493,69 @@ contains
     type(empm_comm_t), intent(in) :: comm          !! the run's processes
     type(empm_snapshot_t), intent(inout) :: sn     !! the snapshot (replaced)
     logical, intent(in) :: blocks                  !! to the blocks of ids, else to the root
-    real(wp), allocatable :: r(:,:), a(:,:)
-    integer, allocatable :: ord(:)
-    integer :: mm, q, o, n, nd, ns, ntotal, first, last
+    real(wp), allocatable :: a(:,:)
+    integer, allocatable :: ord(:), dest(:)
+    integer :: q, n, ntotal, first, last
     if (allocated(sn%file)) return
-    nd = size(sn%x, 1); ns = size(sn%state, 1)
     n = size(sn%id) ! the particles it held then (before a re-cut, perhaps)
     ntotal = comm%sum_int(n)
     first = 1; last = ntotal
     if (blocks) then
       first = id_block_start(comm%rank, ntotal, comm%nranks) + 1
       last = id_block_start(comm%rank + 1, ntotal, comm%nranks)
+      dest = [(id_block_owner(sn%id(q), ntotal, comm%nranks), q = 1, n)]
     else if (.not. comm%is_root()) then
       last = 0
     end if
-    mm = 1 + 2 * nd + 12 + 3 + ns
-    allocate(r(mm, n))
-    o = 1 + 2 * nd
-    do q = 1, n
-      r(1, q) = real(sn%id(q), wp)
-      r(2:1 + nd, q) = sn%x(:, q); r(2 + nd:1 + 2 * nd, q) = sn%v(:, q)
-      r(o + 1:o + 6, q) = sn%stress(:, q); r(o + 7:o + 12, q) = sn%strain(:, q)
-      r(o + 13, q) = sn%m(q); r(o + 14, q) = sn%vol(q); r(o + 15, q) = sn%rho(q)
-      r(o + 16:o + 15 + ns, q) = sn%state(:, q)
-    end do
-    if (blocks) then
-      call comm%exchange_rows(r, n, [(id_block_owner(sn%id(q), ntotal, comm%nranks), &
-        q = 1, n)], a)
-    else
-      call comm%gather_rows(r, n, a)
-      ! What another process held went to the root.
-      if (.not. comm%is_root()) then
-        if (allocated(a)) deallocate(a)
-        allocate(a(mm, 0))
-      end if
-    end if
-    deallocate(r)
-    ! Particle q of the snapshot is id first + q − 1, in column ord(q) of a.
+    ! Field by field, each in the same order (the exchange keeps each process's order): a
+    ! process holds a few copies of one field at a time, not of the whole snapshot. The ids
+    ! first: particle q of the result is id first + q − 1, arrived in column ord(q).
+    call move(reshape(real(sn%id(1:n), wp), [1, n]))
     allocate(ord(max(last - first + 1, 0)))
     do q = 1, size(a, 2)
       ord(nint(a(1, q)) - first + 1) = q
     end do
-    sn%x = a(2:1 + nd, ord); sn%v = a(2 + nd:1 + 2 * nd, ord)
-    sn%stress = a(o + 1:o + 6, ord); sn%strain = a(o + 7:o + 12, ord)
-    sn%m = a(o + 13, ord); sn%vol = a(o + 14, ord); sn%rho = a(o + 15, ord)
-    sn%state = a(o + 16:o + 15 + ns, ord)
+    call move2(sn%x); call move2(sn%v); call move2(sn%stress); call move2(sn%strain)
+    call move2(sn%state)
+    call move1(sn%m); call move1(sn%vol); call move1(sn%rho)
     sn%id = [(q, q = first, last)]
+  contains
+    ! This process's columns of `rows` to where they go, received in `a`.
+    subroutine move(rows)
+      real(wp), intent(in), contiguous :: rows(:,:)
+      integer :: m
+      m = size(rows, 1)
+      if (allocated(a)) deallocate(a)
+      if (blocks) then
+        call comm%exchange_rows(rows, n, dest, a)
+      else
+        call comm%gather_rows(rows, n, a)
+        ! What another process held went to the root.
+        if (.not. comm%is_root()) then
+          if (allocated(a)) deallocate(a)
+          allocate(a(m, 0))
+        end if
+      end if
+    end subroutine move
+    subroutine move2(f)
+      real(wp), allocatable, intent(inout) :: f(:,:)
+      integer :: m
+      m = size(f, 1)
+      if (m == 0) then ! no state variables: nothing to send
+        deallocate(f); allocate(f(0, size(ord))); return
+      end if
+      call move(f)
+      deallocate(f)
+      f = a(:, ord)
+      deallocate(a)
+    end subroutine move2
+    subroutine move1(f)
+      real(wp), allocatable, intent(inout) :: f(:)
+      call move(reshape(f, [1, n]))
+      deallocate(f)
+      f = a(1, ord)
+      deallocate(a)
+    end subroutine move1
   end subroutine empm_gather_snapshot
 
   ! The first id's position (0-based) of process r's block of ids, of ntotal on nranks
