@@ -10,6 +10,7 @@
 !> process (the same error everywhere), so that no process holds the whole list.
 module empm_bodies
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, EMPM_ERR_INPUT, EMPM_OK
   use empm_strings, only: str, lower
@@ -35,6 +36,18 @@ module empm_bodies
   !> Largest magnitude of a coordinate [m] or a speed [m/s], and of a stress [Pa], accepted from
   !> a file (the case reader's bounds): mass, momentum and energy sums then cannot overflow.
   real(wp), parameter :: XMAX = 1.0e15_wp, SMAX = 1.0e30_wp
+
+  ! A text file read a chunk at a time, line by line ([[reader_next]]).
+  integer, parameter :: CHUNK = 1048576
+  type :: line_reader_t
+    integer :: u = -1                            ! the open unit (stream access)
+    integer(int64) :: size = 0                   ! the file's bytes
+    integer(int64) :: pos = 1                    ! its next byte to read
+    character(len=:), allocatable :: buf         ! bytes read, returned up to b − 1
+    integer :: b = 1
+  contains
+    procedure :: next => reader_next
+  end type line_reader_t
 
   !> CSV column names: position, volume, velocity, stress (Voigt order).
   character(len=6), parameter :: COLS(13) = [character(len=6) :: 'x', 'y', 'z', 'volume', &
@@ -115,16 +128,19 @@ contains
     real(wp) :: r, row(13)
     integer :: u, ios, lnum, nf, ncol, k, c, n, total, hline
     logical :: header_done, big, ok
-    ! Line by line: the text is never held whole.
-    open(newunit=u, file=path, status='old', action='read', form='formatted', &
-         access='sequential', iostat=ios, iomsg=msg)
+    type(line_reader_t) :: rd
+    ! Line by line, a chunk of the file at a time: the text is never held whole.
+    open(newunit=u, file=path, status='old', action='read', form='unformatted', &
+         access='stream', iostat=ios, iomsg=msg)
     if (ios /= 0) then
       call err%set(EMPM_ERR_INPUT, 'cannot read the point list: '//trim(msg), file=path); return
     end if
+    rd%u = u; rd%buf = ''
+    inquire(unit=u, size=rd%size)
     header_done = .false.; n = 0; total = 0; lnum = 0; ncol = 0; hline = 0
     allocate(val(13, 256))
     do
-      call get_line(u, ln, ios)
+      call rd%next(ln, ios)
       if (ios /= 0) exit
       lnum = lnum + 1
       if (len(ln) > 0) then
@@ -241,23 +257,38 @@ contains
     end subroutine header
   end subroutine read_csv
 
-  ! The next line of unit u (any length), without its end; ios < 0 at the end of the file.
-  subroutine get_line(u, ln, ios)
-    integer, intent(in) :: u
+  ! The next line of the file (any length), without its end; ios < 0 at the end of the file,
+  ! > 0 when reading failed. The last line needs no newline.
+  subroutine reader_next(self, ln, ios)
+    class(line_reader_t), intent(inout) :: self
     character(len=:), allocatable, intent(out) :: ln
     integer, intent(out) :: ios
-    character(len=4096) :: buf
-    integer :: got
-    ln = ''
+    character(len=:), allocatable :: piece
+    integer :: i, n
+    ios = 0
     do
-      read(u, '(a)', advance='no', iostat=ios, size=got) buf
-      ln = ln//buf(1:got)
-      if (ios /= 0) exit
+      i = index(self%buf(self%b:), new_line('a'))
+      if (i > 0) then
+        ln = self%buf(self%b:self%b + i - 2); self%b = self%b + i; return
+      end if
+      if (self%pos > self%size) then
+        if (self%b > len(self%buf)) then
+          ln = ''; ios = -1; return
+        end if
+        ln = self%buf(self%b:); self%b = len(self%buf) + 1; return
+      end if
+      ! The unread tail, then the next chunk of the file.
+      n = int(min(int(CHUNK, int64), self%size - self%pos + 1))
+      allocate(character(len=n) :: piece)
+      read(self%u, pos=self%pos, iostat=ios) piece
+      if (ios /= 0) then
+        ios = 1; return
+      end if
+      self%pos = self%pos + n
+      self%buf = self%buf(self%b:)//piece; self%b = 1
+      deallocate(piece)
     end do
-    ! The end of a line is a whole line; so is a last line without a newline.
-    if (is_iostat_eor(ios)) ios = 0
-    if (is_iostat_end(ios) .and. len(ln) > 0) ios = 0
-  end subroutine get_line
+  end subroutine reader_next
 
   !> Columns for directions beyond ndim (z in 2D, vy in 1D, ...): accepted when 0.
   pure logical function beyond(c, ndim)
