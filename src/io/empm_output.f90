@@ -647,8 +647,9 @@ contains
   subroutine empm_output_claim(path, err)
     character(len=*), intent(in) :: path         !! output HDF5 file
     type(empm_error_t), intent(out) :: err       !! error, code 0 on success
-    character(len=:), allocatable :: lock, xmf
-    integer :: u, ios, pid, attempt, info
+    character(len=*), parameter :: SUFFIX(3) = [character(len=5) :: '', '.h5', '.hdf5']
+    character(len=:), allocatable :: lock, xmf, sibling, stem
+    integer :: u, ios, pid, attempt, info, k
     xmf = empm_xdmf_path(path)
     select case (empm_path_kind(path))
     case (PATH_MISSING, PATH_REGULAR)
@@ -668,6 +669,21 @@ contains
         'snapshots go as they are taken, exists and is not a folder; refusing to replace it')
       return
     end if
+    ! `k`, `k.h5` and `k.hdf5` share their XDMF file (k.xmf), the first two their checkpoints
+    ! (k.ckpt.h5): a live run on another of these names holds them.
+    stem = trim(path)
+    if (ends(stem, '.h5')) stem = stem(1:len(stem) - 3)
+    if (ends(stem, '.hdf5')) stem = stem(1:len(stem) - 5)
+    do k = 1, 3
+      sibling = stem//trim(SUFFIX(k))
+      if (sibling == trim(path)) cycle
+      pid = lock_owner(sibling//'.lock')
+      if (pid <= 0) cycle
+      if (.not. empm_process_alive(pid)) cycle
+      call err%set(EMPM_ERR_IO, path//': another run (process '//itoa(pid)//') is writing '// &
+        sibling//', which shares its XDMF file or checkpoints (lock '//sibling//'.lock); '// &
+        'wait for it or choose another -o'); return
+    end do
     lock = path//'.lock'
     do attempt = 1, 2
       ! status 'new' creates the file exclusively (O_EXCL): one process wins.
@@ -693,6 +709,11 @@ contains
     call err%set(EMPM_ERR_IO, path//': cannot take the lock '//lock// &
       ' (remove it if no run is writing '//path//')')
   contains
+    logical function ends(str_, tail)
+      character(len=*), intent(in) :: str_, tail
+      ends = .false.
+      if (len(str_) > len(tail)) ends = str_(len(str_) - len(tail) + 1:) == tail
+    end function ends
     integer function lock_owner(f) result(p)
       character(len=*), intent(in) :: f
       integer :: v, ios2

@@ -2,7 +2,8 @@
 """Output-path robustness of `empm run` (one scenario per call; CTest runs each):
 
   concurrent  two runs writing the same -o: the second is refused at its start (status 4,
-              naming the other process); the first completes (status 0, a complete file
+              naming the other process), and so is one on -o OUT without .h5 (the same
+              XDMF file and checkpoints); the first completes (status 0, a complete file
               with non-zero data); no partial or lock file is left.
   stale_lock  a lock left by a killed run (a dead process id) is taken over (status 0).
   fifo        an existing non-regular file (a FIFO) as -o: refused (status 2, naming it),
@@ -82,7 +83,12 @@ def concurrent(empm, cases, work):
     case, out = os.path.join(cases, "long.nml"), "same.h5"
     a = start_long_run(empm, cases, work, out, "the second could start")
     b = run(empm, [case, "-o", out], work)
+    # `same` shares same.h5's XDMF file and checkpoints: refused too while it runs.
+    c = run(empm, [case, "-o", "same"], work)
     a_out, a_err = a.communicate(timeout=120)
+    if c.returncode != 4 or "same.h5" not in c.stderr or f"process {a.pid}" not in c.stderr:
+        fail(f"-o same beside -o same.h5: status {c.returncode}: {c.stderr[-300:]}")
+    print(f"-o same beside -o same.h5 -> status 4: {c.stderr.strip()[:150]}")
     print(f"first run -> status {a.returncode}\n{a_out}{a_err}")
     if b.returncode != 4:
         fail(f"second run: status {b.returncode}, expected 4")
