@@ -570,9 +570,10 @@ contains
     do d = 1, grid%ndim
       a(d) = first_index((lo(d) - tol - grid%origin(d)) * grid%inv_h(d)) - 1
       b(d) = first_index((hi(d) + tol - grid%origin(d)) * grid%inv_h(d)) + 1
-      ! Coordinates too large for the cell size to tell nodes apart (a node's coordinate
-      ! rounds to a neighbour's): every node of the line is a candidate, as in a full scan.
-      if (spacing(max(abs(grid%origin(d)), abs(top(d)))) > 1.0e-6_wp * grid%h(d)) then
+      ! Coordinates too large for the cell size (their rounding a fair part of a cell, which
+      ! the range's one node of margin may not cover): every node of the line is a candidate,
+      ! as in a scan of every node.
+      if (spacing(max(abs(grid%origin(d)), abs(top(d)))) > 0.1_wp * grid%h(d)) then
         a(d) = 0; b(d) = grid%nn(d) - 1
       end if
       a(d) = max(a(d), 0); b(d) = min(b(d), grid%nn(d) - 1)

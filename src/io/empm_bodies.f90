@@ -43,8 +43,11 @@ module empm_bodies
     integer :: u = -1                            ! the open unit (stream access)
     integer(int64) :: size = 0                   ! the file's bytes
     integer(int64) :: pos = 1                    ! its next byte to read
-    character(len=:), allocatable :: buf         ! bytes read, returned up to b − 1
-    integer :: b = 1
+    character(len=:), allocatable :: buf         ! bytes read: buf(b:fill) not yet returned
+    integer :: b = 1                             ! first byte not yet returned
+    integer :: fill = 0                          ! bytes of buf in use
+    integer :: seen = 1                          ! buf(b:seen - 1) holds no newline
+    character(len=256) :: msg = ''               ! the system's reason of a failed read
   contains
     procedure :: next => reader_next
   end type line_reader_t
@@ -135,7 +138,7 @@ contains
     if (ios /= 0) then
       call err%set(EMPM_ERR_INPUT, 'cannot read the point list: '//trim(msg), file=path); return
     end if
-    rd%u = u; rd%buf = ''
+    rd%u = u
     inquire(unit=u, size=rd%size)
     header_done = .false.; n = 0; total = 0; lnum = 0; ncol = 0; hline = 0
     allocate(val(13, 256))
@@ -201,8 +204,8 @@ contains
     end do
     close(u)
     if (ios > 0) then
-      call err%set(EMPM_ERR_INPUT, 'cannot read the point list after line '//str(lnum), &
-        file=path); return
+      call err%set(EMPM_ERR_INPUT, 'cannot read the point list after line '//str(lnum)// &
+        ': '//trim(rd%msg), file=path); return
     end if
     if (.not. header_done) then
       call err%set(EMPM_ERR_INPUT, 'empty point list: expected a header line naming the '// &
@@ -263,30 +266,41 @@ contains
     class(line_reader_t), intent(inout) :: self
     character(len=:), allocatable, intent(out) :: ln
     integer, intent(out) :: ios
-    character(len=:), allocatable :: piece
-    integer :: i, n
+    character(len=:), allocatable :: grown
+    integer :: i, n, tail
     ios = 0
+    if (.not. allocated(self%buf)) allocate(character(len=CHUNK) :: self%buf)
     do
-      i = index(self%buf(self%b:), new_line('a'))
+      ! A line's search resumes where the last one stopped: linear in its length.
+      i = index(self%buf(self%seen:self%fill), new_line('a'))
       if (i > 0) then
-        ln = self%buf(self%b:self%b + i - 2); self%b = self%b + i; return
+        i = self%seen + i - 1
+        ln = self%buf(self%b:i - 1); self%b = i + 1; self%seen = self%b; return
       end if
+      self%seen = self%fill + 1
       if (self%pos > self%size) then
-        if (self%b > len(self%buf)) then
+        if (self%b > self%fill) then
           ln = ''; ios = -1; return
         end if
-        ln = self%buf(self%b:); self%b = len(self%buf) + 1; return
+        ln = self%buf(self%b:self%fill); self%b = self%fill + 1; self%seen = self%b; return
       end if
-      ! The unread tail, then the next chunk of the file.
+      ! The unread tail to the front, room doubled when a line outgrows it, then the next
+      ! chunk of the file.
+      tail = self%fill - self%b + 1
       n = int(min(int(CHUNK, int64), self%size - self%pos + 1))
-      allocate(character(len=n) :: piece)
-      read(self%u, pos=self%pos, iostat=ios) piece
+      if (tail + n > len(self%buf)) then
+        allocate(character(len=max(2 * len(self%buf), tail + n)) :: grown)
+        grown(1:tail) = self%buf(self%b:self%fill)
+        call move_alloc(grown, self%buf)
+      else if (self%b > 1) then
+        self%buf(1:tail) = self%buf(self%b:self%fill)
+      end if
+      self%seen = self%seen - self%b + 1; self%b = 1; self%fill = tail
+      read(self%u, pos=self%pos, iostat=ios, iomsg=self%msg) self%buf(tail + 1:tail + n)
       if (ios /= 0) then
         ios = 1; return
       end if
-      self%pos = self%pos + n
-      self%buf = self%buf(self%b:)//piece; self%b = 1
-      deallocate(piece)
+      self%pos = self%pos + n; self%fill = tail + n
     end do
   end subroutine reader_next
 
