@@ -27,7 +27,7 @@ module empm_checkpoint
   use empm_history, only: empm_history_t, empm_snapshot_t
   use empm_solver, only: empm_solver_state_t
   use empm_particle_gen, only: empm_deal_t
-  use empm_output, only: empm_shared_file_t
+  use empm_output, only: empm_shared_file_t, empm_frame_header
   implicit none
   private
   public :: empm_checkpoint_write, empm_checkpoint_read, empm_checkpoint_path
@@ -520,16 +520,14 @@ contains
   ! '' when group `sn%frame` of `sn%file` holds the snapshot `sn` (its time and step) of `np`
   ! particles, else why not (words following "which").
   function snapshot_problem(sn, np, case_text) result(why)
-    use hdf5, only: h5gopen_f, h5gclose_f, hsize_t
     type(empm_snapshot_t), intent(in) :: sn
     integer, intent(in) :: np
     character(len=*), intent(in) :: case_text
     character(len=:), allocatable :: why
     character(len=:), allocatable :: text
-    integer(hid_t) :: fid, loc
-    integer(hsize_t), allocatable :: dims(:)
-    integer :: e, step, ie
-    real(wp) :: t(1)
+    integer(hid_t) :: fid
+    integer :: e, step, ie, n
+    real(wp) :: t
     why = ''
     call h5_open_read(sn%file, fid, e)
     select case (e)
@@ -548,17 +546,12 @@ contains
       call h5_close_file(fid, ie)
       why = 'was written for another case file'; return
     end if
-    loc = fid
-    if (len(sn%frame) > 0) call h5gopen_f(fid, sn%frame, loc, e)
-    if (e == 0) call h5_read_attr(loc, 'step', step, e)
-    if (e == 0) call h5_read_attr(loc, 'time', t, e)
-    if (e == 0) call h5_dims(loc, 'mass', dims, e)
-    if (loc /= fid .and. e == 0) call h5gclose_f(loc, ie)
+    call empm_frame_header(fid, sn%frame, t, step, n, e)
     call h5_close_file(fid, ie)
     if (e /= 0) then
       why = 'has no snapshot at "'//sn%frame//'/"'
-    else if (step /= sn%step .or. t(1) /= sn%t .or. any(dims /= np)) then
-      why = 'holds another (step '//str(step)//', t = '//str(t(1))//' s)'
+    else if (step /= sn%step .or. t /= sn%t .or. n /= np) then
+      why = 'holds another (step '//str(step)//', t = '//str(t)//' s, '//str(n)//' particles)'
     end if
   end function snapshot_problem
 

@@ -46,7 +46,7 @@ module empm_output
   private
   public :: empm_write_results, empm_output_meta_t, empm_xdmf_path
   public :: empm_output_claim, empm_output_release, empm_partial_name, empm_shared_file_t
-  public :: empm_write_snapshot_file, empm_staging_path
+  public :: empm_write_snapshot_file, empm_staging_path, empm_frame_header
 
   !> An HDF5 file written by the processes of a run: together (parallel HDF5, each process
   !> holding a block of consecutive particle ids, [[empm_h5_collective]]) or by one process.
@@ -190,14 +190,10 @@ contains
         if (rk /= 0) then
           rfail = 1; held = empty_frame(model%grid%ndim, model%pts%nstate, np)
         end if
+        call write_snapshot(held)
       else
-        held = hist%snap(k)
+        call write_snapshot(hist%snap(k))
       end if
-      ! Particles keep their material for the whole run: the current indices apply.
-      n = min(size(held%m), np)
-      call write_frame(g, held%x(:, 1:n), model%pts%x0(:, 1:n), held%v(:, 1:n), &
-        held%stress(:, 1:n), held%strain(:, 1:n), held%m(1:n), held%vol(1:n), held%rho(1:n), &
-        held%state(:, 1:n), model%pts%mat(1:n), snames, scol, sf%pp, ierr)
       call h5_close_group(g, ierr)
     end do
     call h5_close_group(gs, ierr)
@@ -271,6 +267,18 @@ contains
       call empm_raise(EMPM_ERR_IO, path//': cannot rename '//xtmp//' to '//xmf//': '// &
         empm_write_reason(oserr), err)
     end if
+
+  contains
+
+    ! A snapshot's frame datasets in group g. Particles keep their material for the whole run:
+    ! the current indices apply.
+    subroutine write_snapshot(sn)
+      type(empm_snapshot_t), intent(in) :: sn
+      n = min(size(sn%m), np)
+      call write_frame(g, sn%x(:, 1:n), model%pts%x0(:, 1:n), sn%v(:, 1:n), sn%stress(:, 1:n), &
+        sn%strain(:, 1:n), sn%m(1:n), sn%vol(1:n), sn%rho(1:n), sn%state(:, 1:n), &
+        model%pts%mat(1:n), snames, scol, sf%pp, ierr)
+    end subroutine write_snapshot
   end subroutine empm_write_results
 
   !> Create `path`'s partial file (name in `tmp`) for this process's `np` particles, with every
@@ -440,27 +448,18 @@ contains
     integer, intent(inout) :: ierr
     character(len=:), allocatable, intent(inout) :: why
     integer(hid_t) :: src
-    integer(hsize_t), allocatable :: dims(:)
-    integer :: e, k, p, r, rs, step
+    integer :: e, k, p, r, rs, step, ntot
     character(len=:), allocatable :: at
     real(wp), allocatable :: buf(:)
-    real(wp) :: t(1)
+    real(wp) :: t
     at = sn%frame
     if (len(at) > 0) at = at//'/'
     got = empty_frame(nd, ns, np)
     call h5_open_read(sn%file, src, e)
     if (e == 0) then
-      call h5_dims(src, at//'mass', dims, e)
-      if (e == 0) then
-        if (size(dims) /= 1) then
-          e = 4
-        else if (dims(1) /= sf%ntotal) then
-          e = 4
-        end if
-      end if
       ! The snapshot of this run at this time: not one another run left there.
-      if (e == 0) call frame_attrs(src, sn%frame, t, step, e)
-      if (e == 0 .and. (t(1) /= sn%t .or. step /= sn%step)) e = 4
+      call empm_frame_header(src, sn%frame, t, step, ntot, e)
+      if (e /= 0 .or. t /= sn%t .or. step /= sn%step .or. ntot /= sf%ntotal) e = 4
       if (e /= 0) call h5_close_file(src, rs)
     end if
     if (e /= 0) then
@@ -519,23 +518,33 @@ contains
     end subroutine failed
   end subroutine read_frame
 
-  ! The `time` and `step` attributes of group `frame` of the open file `fid` ('' its root).
-  subroutine frame_attrs(fid, frame, t, step, e)
+  !> The `time` and `step` attributes of a snapshot (group `frame` of the open file `fid`, ''
+  !> its root) and its number of particles (the extent of its `mass`); e ≠ 0 when one of them
+  !> is missing or `mass` is not a list.
+  subroutine empm_frame_header(fid, frame, t, step, n, e)
     use hdf5, only: h5gopen_f, h5gclose_f
-    integer(hid_t), intent(in) :: fid
-    character(len=*), intent(in) :: frame
-    real(wp), intent(out) :: t(1)
-    integer, intent(out) :: step, e
+    integer(hid_t), intent(in) :: fid          !! an open file
+    character(len=*), intent(in) :: frame      !! the snapshot's group ('' the root)
+    real(wp), intent(out) :: t                 !! its time [s]
+    integer, intent(out) :: step               !! its step
+    integer, intent(out) :: n                  !! its particles
+    integer, intent(out) :: e                  !! 0 when all were read
     integer(hid_t) :: loc
+    integer(hsize_t), allocatable :: dims(:)
+    real(wp) :: tt(1)
     integer :: ie
-    t = 0.0_wp; step = -1; e = 0
+    t = 0.0_wp; step = -1; n = -1; e = 0
     loc = fid
     if (len(frame) > 0) call h5gopen_f(fid, frame, loc, e)
     if (e /= 0) return
-    call h5_read_attr(loc, 'time', t, e)
+    call h5_read_attr(loc, 'time', tt, e)
     call h5_read_attr(loc, 'step', step, e)
+    call h5_dims(loc, 'mass', dims, e)
+    if (e == 0 .and. size(dims) /= 1) e = 1
+    if (e == 0) n = int(dims(1))
+    t = tt(1)
     if (loc /= fid) call h5gclose_f(loc, ie)
-  end subroutine frame_attrs
+  end subroutine empm_frame_header
 
   ! A snapshot of np particles, zero (what is written when reading one failed: the file is
   ! then removed).
