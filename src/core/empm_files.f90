@@ -8,7 +8,7 @@ module empm_files
   implicit none
   private
   public :: empm_rename, empm_remove, empm_mkdir_p, empm_read_text, empm_physical_memory, &
-            empm_proc_kib, empm_peak_memory, empm_rmdir, empm_absolute
+            empm_proc_kib, empm_peak_memory, empm_rmdir, empm_absolute, empm_path_beside
 
   interface
     function c_rename(old, new) bind(C, name='rename') result(r)
@@ -54,6 +54,20 @@ contains
     character(len=*), intent(in) :: path !! file to remove
     info = int(c_remove(path//c_null_char))
   end function empm_remove
+
+  !> `file` as named beside `ref`: relative to the folder of `ref` (a body file beside its
+  !> case file, a snapshot beside its checkpoint); an absolute `file` is kept as is.
+  pure function empm_path_beside(ref, file) result(path)
+    character(len=*), intent(in) :: ref        !! the file `file` is named beside
+    character(len=*), intent(in) :: file       !! as written there
+    character(len=:), allocatable :: path      !! path to open
+    integer :: s
+    path = trim(adjustl(file))
+    if (len(path) == 0) return
+    if (path(1:1) == '/') return
+    s = index(ref, '/', back=.true.)
+    if (s > 0) path = ref(1:s)//path
+  end function empm_path_beside
 
   !> Remove the folder `path` if it is empty (never a file); returns 0 on success.
   integer function empm_rmdir(path) result(info)

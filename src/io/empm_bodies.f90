@@ -19,7 +19,7 @@ module empm_bodies
   use hdf5, only: hsize_t
   implicit none
   private
-  public :: empm_body_points_t, empm_read_body, empm_body_path
+  public :: empm_body_points_t, empm_read_body
 
   !> The points of one body, before they become particles.
   type :: empm_body_points_t
@@ -57,19 +57,6 @@ module empm_bodies
     'vx', 'vy', 'vz', 'sxx', 'syy', 'szz', 'syz', 'sxz', 'sxy']
 
 contains
-
-  !> `file` relative to the folder of `case_file` (an absolute `file` is kept as is).
-  pure function empm_body_path(case_file, file) result(path)
-    character(len=*), intent(in) :: case_file  !! the case file's path
-    character(len=*), intent(in) :: file       !! as written in the case file
-    character(len=:), allocatable :: path      !! path to open
-    integer :: s
-    path = trim(adjustl(file))
-    if (len(path) == 0) return
-    if (path(1:1) == '/') return
-    s = index(case_file, '/', back=.true.)
-    if (s > 0) path = case_file(1:s)//path
-  end function empm_body_path
 
   !> Read the body in `path` (format from the extension) for an `ndim`-dimensional case.
   !> `order` is the quadrature order per direction for a mesh (the case's `ppc`).

@@ -18,7 +18,7 @@ module empm_checkpoint
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO, EMPM_ERR_INPUT
   use empm_h5, only: h5_group, h5_close_group, h5_write, h5_attr, h5_open_read, &
     h5_close_file, h5_exists, h5_dims, h5_read, h5_read_attr
-  use empm_files, only: empm_rename, empm_remove, empm_absolute
+  use empm_files, only: empm_rename, empm_remove, empm_absolute, empm_path_beside
   use empm_posix, only: empm_errno, empm_errno_text, empm_write_reason, empm_path_kind, &
     PATH_REGULAR
   use empm_version_info, only: empm_version
@@ -383,16 +383,6 @@ contains
 
   contains
 
-    ! A name the checkpoint holds relative to its own folder (wherever the restart runs from).
-    function resolved(rel) result(file)
-      character(len=*), intent(in) :: rel
-      character(len=:), allocatable :: file
-      file = rel
-      if (len(rel) > 0) then
-        if (rel(1:1) /= '/') file = folder_of(path)//rel
-      end if
-    end function resolved
-
     subroutine refuse(why)
       character(len=*), intent(in) :: why
       integer :: ie
@@ -481,7 +471,7 @@ contains
           call h5_read_attr(gk, 'frame', fr, ierr)
           if (ierr /= 0) exit
           sn%frame = trim(fr) ! '' is stored as ' '
-          sn%file = resolved(rel)
+          sn%file = empm_path_beside(path, rel)
           why = snapshot_problem(sn, np, case_text)
           if (len(why) > 0) then
             ! Its own file is gone once the results of the run that took it hold it (a run
@@ -493,8 +483,8 @@ contains
             alt%file = results_of(sn%file)
             why_alt = 'is not named'
             if (len(alt%file) > 0) why_alt = snapshot_problem(alt, np, case_text)
-            if (len(why_alt) > 0 .and. alt%file /= resolved(results)) then
-              alt%file = resolved(results)
+            if (len(why_alt) > 0 .and. alt%file /= empm_path_beside(path, results)) then
+              alt%file = empm_path_beside(path, results)
               why_alt = snapshot_problem(alt, np, case_text)
             end if
             if (len(why_alt) == 0) then

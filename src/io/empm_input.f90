@@ -15,7 +15,7 @@ module empm_input
   use empm_parallel, only: empm_max_threads
   use empm_error, only: empm_error_t, empm_raise_error, EMPM_ERR_INPUT, EMPM_OK
   use empm_strings, only: str, str_short
-  use empm_files, only: empm_read_text, empm_physical_memory
+  use empm_files, only: empm_read_text, empm_physical_memory, empm_path_beside
   use empm_params, only: empm_param_t, empm_param, empm_params_markdown, empm_param_names, &
                          PARAM_REAL, PARAM_INT, PARAM_STR, PARAM_LOGICAL
   use empm_namelist, only: empm_group_t, empm_parse_namelist
@@ -32,7 +32,7 @@ module empm_input
   use empm_shape, only: shape_status_text
   use empm_registry, only: empm_registry_t, empm_default_registry
   use empm_solver, only: empm_run_params
-  use empm_bodies, only: empm_body_points_t, empm_read_body, empm_body_path
+  use empm_bodies, only: empm_body_points_t, empm_read_body
   implicit none
   private
   public :: empm_read_case, empm_input_markdown, empm_input_group_params, empm_check_basis
@@ -699,7 +699,7 @@ contains
             str(nbody)//')'); return
         end if
       end do
-      full = empm_body_path(path, file)
+      full = empm_path_beside(path, file)
       ! Shared, this process keeps the points dealt to it only: those whose ids (the next
       ! ones, in the file's order) are its own.
       call empm_read_body(full, nd, ppc, body, e, keep=[modulo(cs%deal%rank - cs%deal%n, &
