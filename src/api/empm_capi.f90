@@ -32,6 +32,7 @@ module empm_capi
   use empm_driver, only: empm_run_case, empm_write_shared
   use empm_comm, only: empm_comm_t, empm_comm_from_handle, empm_comm_handle_problem
   use empm_partition, only: empm_partition_particles, empm_copy_for_output
+  use empm_particle_gen, only: empm_deal_t
   implicit none
   private
   public :: empm_capi_box_t
@@ -57,6 +58,11 @@ module empm_capi
     character(len=:), allocatable :: case_file         !! '' for a programmatic model
     character(len=:), allocatable :: case_text         !! text of the case file
     logical :: ready = .false.                         !! finalized, may step
+    !> On a communicator from before the first particle: the particles added, dealt out (each
+    !> process stores every `deal%every`-th), and the grid's fields not allocated until the
+    !> windows (docs/embedding.md, "MPI")
+    logical :: dealt = .false.
+    type(empm_deal_t) :: deal                          !! the dealing (ids, this process)
     integer :: nmat = 0                                !! materials added
     character(len=MSG_LEN) :: message = ''             !! last error ('' after a success)
   end type empm_capi_box_t
@@ -167,13 +173,17 @@ contains
 
   !> Run a programmatic model on the processes of a host's communicator (its Fortran handle;
   !> before finalize). Every process then makes the same calls: it adds every particle, and
-  !> finalize keeps those of its box ([[empm_partition_particles]]). Fields, `info` and
-  !> `set_field` are then this process's particles (field "id": their numbers in the order they
-  !> were added); steps, energies and `write` (the root writes every particle) are collective.
+  !> finalize moves each to the process of its box ([[empm_partition_particles]]). Called
+  !> before the first particle is added, each process stores only every P-th particle as they
+  !> are added, and no nodal field of the whole grid (the set-up of `empm run` under MPI);
+  !> called later, each stores every particle until finalize. Fields, `info` and `set_field`
+  !> are then this process's particles (field "id": their numbers in the order they were
+  !> added); steps, energies and `write` (the root writes every particle) are collective.
   integer function capi_set_comm(b, handle) result(rc)
     type(empm_capi_box_t), pointer, intent(in) :: b !! box
     integer, intent(in) :: handle                   !! the host's communicator
     type(empm_comm_t) :: comm
+    type(empm_error_t) :: e
     integer :: info
     rc = check_open(b, 'empm_model_set_comm', .true.)
     if (rc /= EMPM_OK) return
@@ -182,9 +192,23 @@ contains
       rc = fail(b, EMPM_ERR_USAGE, 'empm_model_set_comm: '//empm_comm_handle_problem(info))
       return
     end if
+    if (b%dealt) then
+      rc = fail(b, EMPM_ERR_USAGE, 'empm_model_set_comm: the model is already on a '// &
+        'communicator and has particles dealt out on it'); return
+    end if
     call b%model%comm%finish()
     b%model%comm = comm
     b%message = ''
+    if (comm%parallel() .and. b%model%pts%np == 0) then
+      b%dealt = .true.
+      b%deal = empm_deal_t(every=comm%nranks, rank=comm%rank)
+      ! Boundaries set from now on are kept as lists (the windows come at finalize); set
+      ! before, they already hold the whole grid's fields, which finalize gives back.
+      if (.not. allocated(b%model%nodes%mass)) then
+        call b%model%nodes%alloc(b%model%grid, e, fields=.false.)
+        rc = remember(b, e)
+      end if
+    end if
   end function capi_set_comm
 
   !> New handle from a case file (read with extra_groups='verify'), finalized and ready to step.
@@ -344,7 +368,8 @@ contains
     real(wp), intent(in) :: rho(:)                  !! densities (n) [kg/m³]
     integer, intent(in) :: mat(:)                   !! material ids (n), 1..number of materials
     type(empm_error_t) :: e
-    integer :: p, d
+    integer :: p, d, id
+    logical :: mine
     real(wp) :: lp(3)
     rc = check_open(b, 'empm_model_add_particles', .true.)
     if (rc /= EMPM_OK) return
@@ -367,9 +392,12 @@ contains
       end if
     end do
     do p = 1, n
+      ! Dealt out (every process checked every particle above): this process's only.
+      call b%deal%next(id, mine)
+      if (b%dealt .and. .not. mine) cycle
       ! Particle domain: a cube of the particle's volume (GIMP-type shapes need its size).
       lp = 0.5_wp * vol(p)**(1.0_wp / d)
-      call b%model%pts%append(x(1:d, p), vol(p), rho(p), lp(1:d), mat(p), e)
+      call b%model%pts%append(x(1:d, p), vol(p), rho(p), lp(1:d), mat(p), e, id=id)
       if (e%code /= EMPM_OK) exit
     end do
     rc = remember(b, e)
@@ -459,7 +487,7 @@ contains
     type(empm_error_t) :: e
     rc = check_open(b, 'empm_model_finalize', .true.)
     if (rc /= EMPM_OK) return
-    if (b%nmat == 0 .or. b%model%pts%np == 0) then
+    if (b%nmat == 0 .or. b%deal%n == 0) then
       rc = fail(b, EMPM_ERR_USAGE, 'empm_model_finalize: add materials and particles first')
       return
     end if
@@ -479,15 +507,15 @@ contains
       rc = fail(b, EMPM_ERR_USAGE, 'empm_model_finalize: integrator '''//b%integ%family()// &
         ''' does not support frictional walls ('//WALL_SCHEMES//' do)'); return
     end if
-    call b%model%finalize_setup(e)
+    call b%model%finalize_setup(e, shared=b%dealt)
     if (e%code == EMPM_OK .and. b%model%comm%parallel()) then
-      ! Every process added every particle: each keeps those of its box.
-      if (b%model%comm%min_int(b%model%pts%np) /= b%model%comm%max_int(b%model%pts%np)) then
+      ! Every process added every particle: each keeps, or is sent, those of its box.
+      if (b%model%comm%min_int(b%deal%n) /= b%model%comm%max_int(b%deal%n)) then
         rc = fail(b, EMPM_ERR_USAGE, 'empm_model_finalize: the processes added different '// &
           'numbers of particles (each must add all of them; finalize shares them out)')
         return
       end if
-      call empm_partition_particles(b%model, e)
+      call empm_partition_particles(b%model, e, dealt=b%dealt)
     end if
     if (e%code == EMPM_OK) call b%hist%init(b%model%grid%ndim, b%probe_name, b%probe_particle, &
                                             1024, 0, e)

@@ -231,7 +231,8 @@ contains
 
   !> `CALL EMPM_SETCOMM(MODEL, ICOMM, IERR)`: before finalize, run the model on the processes
   !> of the INTEGER communicator ICOMM (mpif.h); every process then makes the same calls and
-  !> adds every particle (docs/embedding.md, "MPI").
+  !> adds every particle (docs/embedding.md, "MPI"). Called before the first particle, each
+  !> process stores only its share of them as they are added.
   subroutine f77_setcomm(model, icomm, ierr) bind(C, name='empm_setcomm_')
     integer(c_int64_t), intent(in) :: model  !! handle
     integer(c_int), intent(in) :: icomm      !! the communicator (Fortran handle)

@@ -1,9 +1,12 @@
 /* A C host that runs empm on its own MPI communicator (CTest capi_mpi_c, under mpirun -n 3;
- * docs/embedding.md, "MPI"). Every process builds the same 2D model twice: alone, and on the
- * host's communicator with empm_model_set_comm. After the same steps the parallel model's
- * particles (this process's share, found by their "id") equal the serial model's to 1e-12,
- * and so do the energies; the results written by the parallel model hold every particle.
- * Then a case file runs on the communicator, and misuse is refused with a status.
+ * docs/embedding.md, "MPI"). Every process builds the same 2D model three times: alone, and on
+ * the host's communicator with empm_model_set_comm called before the particles (dealt out as
+ * they are added) and after them (each process holds every one until finalize). After the same
+ * steps the parallel models' particles (this process's share, found by their "id") equal the
+ * serial model's to 1e-12, and so do the energies; the results written by a parallel model hold
+ * every particle. Adding many particles after set_comm takes a process about 1/P of the memory
+ * they take when it is called after them. Then a case file runs on the communicator, and misuse
+ * is refused with a status.
  * Usage: mpi_host case.nml out_dir */
 #include <math.h>
 #include <stdio.h>
@@ -20,8 +23,52 @@
 
 #include "check.h"
 
+/* Resident memory of this process [KiB] (VmRSS). */
+static long resident_kib(void)
+{
+  char line[256];
+  long kib = -1;
+  FILE *f = fopen("/proc/self/status", "r");
+  if (!f) return -1;
+  while (fgets(line, sizeof line, f))
+    if (strncmp(line, "VmRSS:", 6) == 0) kib = strtol(line + 6, NULL, 10);
+  fclose(f);
+  return kib;
+}
+
+/* The memory [KiB] a process's model holds after `n` particles are added in 2D, with
+ * set_comm called before them (first = 1) or after them (first = 0). */
+static long held_after_adding(int first, int n, MPI_Comm comm)
+{
+  double origin[2] = {0, 0}, h[2] = {1.0 / 512, 1.0 / 512};
+  int ncell[2] = {512, 512}, imat = 0, p;
+  double *x = malloc(sizeof *x * 2 * (size_t)n), *vol = malloc(sizeof *vol * (size_t)n);
+  double *rho = malloc(sizeof *rho * (size_t)n);
+  int *mat = malloc(sizeof *mat * (size_t)n);
+  char err[256];
+  long before, after;
+  empm_model *m = NULL;
+  CHECK(empm_model_create(2, origin, h, ncell, &m, err, sizeof err) == EMPM_OK);
+  CHECK(empm_model_add_material(m, "linear_elastic", "E = 1e6, nu = 0.25, density = 2000",
+                                &imat) == EMPM_OK);
+  for (p = 0; p < n; p++) {
+    x[2 * p] = (p % 1000 + 0.5) / 1000.0; x[2 * p + 1] = (p / 1000 + 0.5) / (n / 1000 + 1.0);
+    vol[p] = 1e-6; rho[p] = 2000; mat[p] = imat;
+  }
+  if (first) CHECK(empm_model_set_comm(m, (int)MPI_Comm_c2f(comm)) == EMPM_OK);
+  before = resident_kib();
+  CHECK(empm_model_add_particles(m, n, x, vol, rho, mat) == EMPM_OK);
+  after = resident_kib();
+  if (!first) CHECK(empm_model_set_comm(m, (int)MPI_Comm_c2f(comm)) == EMPM_OK);
+  CHECK(empm_model_finalize(m) == EMPM_OK);
+  empm_model_destroy(m);
+  free(x); free(vol); free(rho); free(mat);
+  return after - before;
+}
+
 /* A strip of NP particles on a frictional base under gravity, moving along x with a wave in its
- * velocity; on `comm` when use_comm. Initial velocities and stresses are set by id. */
+ * velocity; alone (use_comm = 0) or on `comm`, set before the particles (1) or after them (2).
+ * Initial velocities and stresses are set by id. */
 static empm_model *strip(int use_comm, MPI_Comm comm)
 {
   static double x[2 * NP], vol[NP], rho[NP];
@@ -34,7 +81,7 @@ static empm_model *strip(int use_comm, MPI_Comm comm)
   size_t n;
   empm_model *m = NULL;
   CHECK(empm_model_create(2, origin, h, ncell, &m, err, sizeof err) == EMPM_OK);
-  if (use_comm) CHECK(empm_model_set_comm(m, (int)MPI_Comm_c2f(comm)) == EMPM_OK);
+  if (use_comm == 1) CHECK(empm_model_set_comm(m, (int)MPI_Comm_c2f(comm)) == EMPM_OK);
   CHECK(empm_model_set_integrator(m, "pc_newmark", NULL) == EMPM_OK);
   CHECK(empm_model_add_material(m, "linear_elastic", "E = 1e6, nu = 0.25, density = 2000",
                                 &imat) == EMPM_OK);
@@ -44,6 +91,7 @@ static empm_model *strip(int use_comm, MPI_Comm comm)
       vol[p] = 0.03125 * 0.03125; rho[p] = 2000; mat[p] = imat;
     }
   CHECK(empm_model_add_particles(m, NP, x, vol, rho, mat) == EMPM_OK);
+  if (use_comm == 2) CHECK(empm_model_set_comm(m, (int)MPI_Comm_c2f(comm)) == EMPM_OK);
   CHECK(empm_model_set_gravity(m, g) == EMPM_OK);
   CHECK(empm_model_friction_box(m, lo, hi, 2, 10.0, &nsel) == EMPM_OK);
   CHECK(empm_model_finalize(m) == EMPM_OK);
@@ -65,25 +113,12 @@ static empm_model *strip(int use_comm, MPI_Comm comm)
   return m;
 }
 
-int main(int argc, char **argv)
+/* The parallel model's particles where the serial model has them (1e-12 of the largest
+ * coordinate), every particle once over the processes, and the same energies. */
+static void compare(empm_model *serial, empm_model *par, const char *label, int rank, int nranks)
 {
-  int rank, nranks, np, ndim, nstep, p, k, all, rc;
+  int np, ndim, nstep, p, k, all;
   double t, ek[2], es[2], eg[2], *xs, *xp, *id, worst = 0, scale = 0, gworst;
-  char msg[512], path[1024];
-  empm_model *serial, *par, *late;
-  if (argc < 3) return 2;
-  MPI_Init(&argc, &argv);
-  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
-  MPI_Comm_size(MPI_COMM_WORLD, &nranks);
-
-  serial = strip(0, MPI_COMM_WORLD);
-  par = strip(1, MPI_COMM_WORLD);
-  CHECK(empm_model_advance_to(serial, 0.1) == EMPM_OK);
-  CHECK(empm_model_advance_to(par, 0.1) == EMPM_OK);
-  CHECK(empm_model_step(serial, 20) == EMPM_OK);
-  CHECK(empm_model_step(par, 20) == EMPM_OK);
-
-  /* Every particle once over the processes, each where the serial model has it. */
   CHECK(empm_model_info(par, &ndim, &np, &t, &nstep) == EMPM_OK);
   MPI_Allreduce(&np, &all, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   CHECK(all == NP);
@@ -105,10 +140,45 @@ int main(int argc, char **argv)
   CHECK(fabs(ek[1] - ek[0]) <= 1e-12 * fabs(ek[0]) && fabs(es[1] - es[0]) <= 1e-12 * fabs(es[0]));
   CHECK(fabs(eg[1] - eg[0]) <= 1e-12 * fabs(eg[0]));
   if (rank == 0)
-    printf("%d processes: largest particle share %d of %d, positions within %.2e, kinetic "
-           "energy %.12e (alone %.12e)\n", nranks, np, NP, gworst, ek[1], ek[0]);
+    printf("%d processes, %s: largest particle share %d of %d, positions within %.2e, kinetic "
+           "energy %.12e (alone %.12e)\n", nranks, label, np, NP, gworst, ek[1], ek[0]);
+  free(xs); free(xp); free(id);
+}
+
+int main(int argc, char **argv)
+{
+  int rank, nranks, rc, order;
+  long held[2], most[2];
+  char msg[512], path[1024];
+  empm_model *serial, *par[2], *late;
+  if (argc < 3) return 2;
+  MPI_Init(&argc, &argv);
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &nranks);
+
+  serial = strip(0, MPI_COMM_WORLD);
+  CHECK(empm_model_advance_to(serial, 0.1) == EMPM_OK);
+  CHECK(empm_model_step(serial, 20) == EMPM_OK);
+  for (order = 0; order < 2; order++) {
+    par[order] = strip(order + 1, MPI_COMM_WORLD);
+    CHECK(empm_model_advance_to(par[order], 0.1) == EMPM_OK);
+    CHECK(empm_model_step(par[order], 20) == EMPM_OK);
+    compare(serial, par[order], order == 0 ? "set_comm before the particles"
+                                           : "set_comm after the particles", rank, nranks);
+  }
+
+  /* 600,000 particles: dealt out as they are added, a process holds about 1/P of them. */
+  held[0] = held_after_adding(1, 600000, MPI_COMM_WORLD);
+  held[1] = held_after_adding(0, 600000, MPI_COMM_WORLD);
+  MPI_Allreduce(held, most, 2, MPI_LONG, MPI_MAX, MPI_COMM_WORLD);
+  if (rank == 0)
+    printf("600000 particles added: at most %ld KiB a process with set_comm before them, "
+           "%ld KiB after them\n", most[0], most[1]);
+  CHECK(most[1] > 0 && most[0] * nranks < 1.5 * most[1]);
+
+  empm_model_destroy(par[1]);
   snprintf(path, sizeof path, "%s/mpi_host_model.h5", argv[2]);
-  CHECK(empm_model_write(par, path) == EMPM_OK);
+  CHECK(empm_model_write(par[0], path) == EMPM_OK);
 
   /* A case file on the communicator: the same status everywhere, one file. */
   snprintf(path, sizeof path, "%s/mpi_host_case.h5", argv[2]);
@@ -120,7 +190,7 @@ int main(int argc, char **argv)
   CHECK(rc != EMPM_OK && strstr(msg, "no-such-case.nml") != NULL);
 
   /* Misuse: a communicator after finalize, and MPI_COMM_NULL. */
-  CHECK(empm_model_set_comm(par, (int)MPI_Comm_c2f(MPI_COMM_WORLD)) == EMPM_ERR_USAGE);
+  CHECK(empm_model_set_comm(par[0], (int)MPI_Comm_c2f(MPI_COMM_WORLD)) == EMPM_ERR_USAGE);
   {
     double origin[1] = {0}, h[1] = {1};
     int ncell[1] = {4};
@@ -130,8 +200,7 @@ int main(int argc, char **argv)
     empm_model_destroy(late);
   }
   empm_model_destroy(serial);
-  empm_model_destroy(par);
-  free(xs); free(xp); free(id);
+  empm_model_destroy(par[0]);
   MPI_Allreduce(MPI_IN_PLACE, &failures, 1, MPI_INT, MPI_SUM, MPI_COMM_WORLD);
   if (rank == 0 && failures == 0) printf("MPI host: all checks passed\n");
   MPI_Finalize();
