@@ -6,8 +6,12 @@
 !> line (for CSV also the column; for HDF5 the dataset and the point).
 !>
 !> Shared among processes, each keeps every `stride`-th point only (`keep`): a CSV file is
-!> read line by line and an HDF5 one in blocks of points, every point checked on every
-!> process (the same error everywhere), so that no process holds the whole list.
+!> read line by line and an HDF5 one in blocks of points, so that no process holds the whole
+!> list. An HDF5 file's points are all checked on every process (the same error everywhere).
+!> A CSV file's lines are all read and their values counted everywhere, but each process
+!> converts and checks the values of its own points only: the conversion is the reading's
+!> cost. Its error is then the first in the file of those it has: the caller agrees on the
+!> earliest line over the processes, which is the error a single process would give.
 module empm_bodies
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_fortran_env, only: int64
@@ -116,7 +120,8 @@ contains
     integer, allocatable :: col(:)        ! column -> index into COLS
     real(wp), allocatable :: val(:,:)     ! (13, capacity): the points kept
     real(wp) :: r, row(13)
-    integer :: u, ios, lnum, nf, ncol, k, c, n, total, hline
+    integer :: u, ios, lnum, nf, ncol, k, c, n, total, hline, i
+    integer :: fb(14), fe(14)             ! a data line's fields: ln(fb(k):fe(k))
     logical :: header_done, big, ok
     type(line_reader_t) :: rd
     ! Line by line, a chunk of the file at a time: the text is never held whole.
@@ -138,8 +143,8 @@ contains
       end if
       if (len_trim(ln) == 0) cycle
       if (index(adjustl(ln), '#') == 1) cycle
-      call split_commas(ln, fld, nf)
       if (.not. header_done) then
+        call split_commas(ln, fld, nf)
         hline = lnum
         call header(fld(1:nf))
         if (err%code /= EMPM_OK) then
@@ -148,43 +153,59 @@ contains
         header_done = .true.; ncol = nf
         cycle
       end if
+      ! The fields, in place (at most 13 columns: a 14th field is one too many).
+      nf = 1; fb(1) = 1
+      do i = 1, len(ln)
+        if (ln(i:i) == ',') then
+          if (nf <= 13) then
+            fe(nf) = i - 1; fb(nf + 1) = i + 1
+          end if
+          nf = nf + 1
+        else if (ln(i:i) == achar(9)) then
+          ln(i:i) = ' '
+        end if
+      end do
+      if (nf <= 14) fe(nf) = len(ln)
       if (nf /= ncol) then
         call err%set(EMPM_ERR_INPUT, 'expected '//str(ncol)//' comma-separated values (as '// &
           'the header at line '//str(hline)//'), got '//str(nf), file=path, line=lnum)
         close(u); return
       end if
+      total = total + 1
+      ! Another process's point: it converts and checks the values.
+      if (total - 1 < keep(1) .or. mod(total - 1 - keep(1), keep(2)) /= 0) cycle
       row = 0.0_wp
       do k = 1, nf
         c = col(k)
-        ok = empm_text_to_real(fld(k), r, big)
+        associate (f => ln(fb(k):fe(k)))
+        ok = empm_text_to_real(f, r, big)
         if (big) r = huge(r)  ! reported as beyond the magnitude bound below
         if (.not. (ok .or. big)) then
           call err%set(EMPM_ERR_INPUT, 'column '//str(k)//' ('''//trim(COLS(c))// &
-            '''): expected a number, got '''//trim(fld(k))//'''', file=path, line=lnum)
+            '''): expected a number, got '''//trim(adjustl(f))//'''', file=path, line=lnum)
           close(u); return
         end if
         if (abs(r) > merge(SMAX, merge(XMAX**ndim, XMAX, c == 4), c >= 8)) then
           call err%set(EMPM_ERR_INPUT, 'column '//str(k)//' ('''//trim(COLS(c))// &
-            '''): '//trim(fld(k))//' is beyond the accepted magnitude ('// &
+            '''): '//trim(adjustl(f))//' is beyond the accepted magnitude ('// &
             trim(merge('1e15 m or m/s; volume 1e15^ndim', '1e30 Pa                        ', &
             c < 8))//')', file=path, line=lnum)
           close(u); return
         end if
         if (c == 4 .and. r <= 0.0_wp) then
           call err%set(EMPM_ERR_INPUT, 'column '//str(k)//' (''volume''): expected a '// &
-            'volume > 0, got '//trim(fld(k)), file=path, line=lnum)
+            'volume > 0, got '//trim(adjustl(f)), file=path, line=lnum)
           close(u); return
         end if
         if (beyond(c, ndim) .and. r /= 0.0_wp) then
           call err%set(EMPM_ERR_INPUT, 'column '//str(k)//' ('''//trim(COLS(c))// &
-            '''): must be 0 in a '//str(ndim)//'-D case, got '//trim(fld(k)), file=path, &
-            line=lnum)
+            '''): must be 0 in a '//str(ndim)//'-D case, got '//trim(adjustl(f)), &
+            file=path, line=lnum)
           close(u); return
         end if
+        end associate
         row(c) = r
       end do
-      total = total + 1
-      if (total - 1 < keep(1) .or. mod(total - 1 - keep(1), keep(2)) /= 0) cycle
       if (n == size(val, 2)) val = reshape(val, [13, 2 * n], pad=[0.0_wp])
       n = n + 1
       val(:, n) = row

@@ -16,6 +16,8 @@
 module empm_gmsh
   use, intrinsic :: iso_fortran_env, only: int64
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
+  use, intrinsic :: iso_c_binding, only: c_char, c_double, c_ptr, c_null_char, c_loc, &
+    c_intptr_t
   use empm_kinds, only: wp
   use empm_error, only: empm_error_t, EMPM_ERR_INPUT, EMPM_OK
   use empm_files, only: empm_read_text
@@ -36,6 +38,16 @@ module empm_gmsh
     integer :: n = 0                     !! lines
     integer :: cur = 0                   !! last line consumed
   end type lines_t
+
+  interface
+    ! The C library's conversion of a decimal text (endptr: the first character not used).
+    function c_strtod(text, endptr) bind(C, name='strtod') result(v)
+      import :: c_char, c_double, c_ptr
+      character(kind=c_char), intent(in) :: text(*)
+      type(c_ptr), intent(out) :: endptr
+      real(c_double) :: v
+    end function c_strtod
+  end interface
 
 contains
 
@@ -563,45 +575,91 @@ contains
 
   ! ---- text helpers --------------------------------------------------------------------------
 
-  !> `t` as a finite real: only a sign, digits, a point and an exponent (e or d) are accepted
-  !> (list-directed reading also takes 'T' or '1.0abc'), and a magnitude beyond 1e300 is
-  !> rejected before conversion (converting 1e400 would trap with -ffpe-trap=overflow).
+  !> The value of one decimal number, `[sign] digits [. digits] [e|E|d|D [sign] digits]` with
+  !> blanks around it, or with a signed exponent without its letter as Fortran writes an
+  !> exponent beyond 99 (`1.5-120`); not 'inf', 'nan', nor hexadecimal.
+  !> Converted by the C library's `strtod`, correctly rounded: the value of Fortran's
+  !> list-directed read, which calls it too (tests/unit/test_number_text.pf), at a fraction of
+  !> its cost; by that read when `strtod` stops short (a host program whose locale's decimal
+  !> point is not '.'). A magnitude of 1e301 or more is refused before conversion (converting
+  !> 1e400 would trap with -ffpe-trap=overflow).
   logical function empm_text_to_real(t, x, too_big) result(ok)
     character(len=*), intent(in) :: t   !! text of one number
     real(wp), intent(out) :: x          !! its value (0 when not ok)
     logical, intent(out), optional :: too_big !! a number, but of magnitude >= 1e301
-    character(len=:), allocatable :: s, m
-    integer :: ios, k, p, ex, lead
+    integer, parameter :: NBUF = 128
+    character(kind=c_char), target :: buf(NBUF)
+    type(c_ptr) :: endp
+    integer :: b, e, i, k, ex, lead, ndig, ios, n, m
+    logical :: point
     x = 0.0_wp; ok = .false.
     if (present(too_big)) too_big = .false.
-    s = trim(adjustl(t))
-    if (len(s) == 0 .or. verify(s, '+-.0123456789eEdD') > 0) return
-    ! Decimal magnitude: digits before the point (leading zeros dropped) plus the exponent.
-    k = scan(s, 'eEdD')
-    ex = 0
-    if (k > 0) then
-      if (len(s) - k > 6) return
-      if (k < len(s)) then
-        if (verify(s(k + 1:), '+-0123456789') > 0) return
-        read(s(k + 1:), *, iostat=ios) ex
-        if (ios /= 0) return
+    e = len_trim(t)
+    if (e == 0) return
+    b = verify(t(1:e), ' ')
+    ! The mantissa: digits with at most one point; its digits before the point, leading zeros
+    ! dropped, give the decimal magnitude with the exponent.
+    i = b
+    if (t(i:i) == '+' .or. t(i:i) == '-') i = i + 1
+    ndig = 0; lead = 0; point = .false.
+    do while (i <= e)
+      if (t(i:i) >= '0' .and. t(i:i) <= '9') then
+        ndig = ndig + 1
+        if (.not. point .and. (lead > 0 .or. t(i:i) /= '0')) lead = lead + 1
+      else if (t(i:i) == '.' .and. .not. point) then
+        point = .true.
+      else
+        exit
       end if
-      m = s(1:k - 1)
-    else
-      m = s
-    end if
-    p = index(m, '.')
-    if (p == 0) p = len(m) + 1
-    lead = 0
-    do k = 1, p - 1
-      if (lead == 0 .and. (m(k:k) == '0' .or. m(k:k) == '+' .or. m(k:k) == '-')) cycle
-      lead = lead + 1
+      i = i + 1
     end do
+    if (ndig == 0) return
+    ex = 0
+    m = 0   ! where the exponent's letter goes in the C text (one without a letter)
+    if (i <= e) then
+      ! The exponent: a letter and a sign, or a sign, then at most 5 digits.
+      if (index('eEdD', t(i:i)) > 0) then
+        i = i + 1
+      else if (t(i:i) == '+' .or. t(i:i) == '-') then
+        m = i - b + 1
+      else
+        return
+      end if
+      k = 1
+      if (i <= e) then
+        if (t(i:i) == '+' .or. t(i:i) == '-') then
+          if (t(i:i) == '-') k = -1
+          i = i + 1
+        end if
+      end if
+      if (i > e .or. e - i + 1 > 5) return
+      if (verify(t(i:e), '0123456789') > 0) return
+      do n = i, e
+        ex = 10 * ex + (iachar(t(n:n)) - iachar('0'))
+      end do
+      ex = k * ex
+    end if
     if (lead + ex > 301) then
       if (present(too_big)) too_big = .true.
       return
     end if
-    read(s, *, iostat=ios) x
+    n = e - b + 1
+    ios = 1
+    if (n + 1 < NBUF) then
+      k = 0
+      do i = 1, n
+        if (i == m) then
+          k = k + 1; buf(k) = 'e'
+        end if
+        k = k + 1; buf(k) = t(b + i - 1:b + i - 1)
+        if (buf(k) == 'd' .or. buf(k) == 'D') buf(k) = 'e'
+      end do
+      n = k
+      buf(n + 1) = c_null_char
+      x = c_strtod(buf, endp)
+      if (transfer(endp, 0_c_intptr_t) - transfer(c_loc(buf), 0_c_intptr_t) == n) ios = 0
+    end if
+    if (ios /= 0) read(t(b:e), *, iostat=ios) x
     ok = ios == 0
     if (ok) ok = ieee_is_finite(x)
     if (.not. ok) x = 0.0_wp

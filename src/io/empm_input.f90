@@ -279,6 +279,7 @@ contains
     type(empm_error_t) :: e
     character(len=:), allocatable :: extra
     logical :: fields
+    integer :: at(2)
 
     cs = empm_case_t()  ! a case object may be read into again
     if (present(overrides)) ov = overrides
@@ -311,8 +312,9 @@ contains
     if (e%code == EMPM_OK) call read_grid(path, gs, cs, ov, e)
     if (e%code == EMPM_OK) call read_materials(path, gs, cs, reg, e)
     if (e%code == EMPM_OK) call read_shape(gs, cs, ov, reg, e)
-    if (e%code == EMPM_OK) call read_particles(path, gs, cs, ov, e)
-    call cs%model%comm%agree(e)
+    at = 0
+    if (e%code == EMPM_OK) call read_particles(path, gs, cs, ov, e, at)
+    call agree_first(cs%model%comm, e, at)
     if (e%code == EMPM_OK) call same_particles(path, cs, e)
     if (e%code == EMPM_OK) call read_integrator(path, gs, cs, ov, reg, e)
     if (e%code == EMPM_OK) call read_loads(gs, cs, e)
@@ -332,6 +334,22 @@ contains
   end subroutine empm_read_case
 
   ! ---- helpers ----------------------------------------------------------------------------
+
+  !> The error every process reports after reading the particles: that of the earliest place
+  !> `at` (body, then line of its file: 0 before it, huge after) over the processes. Dealt out,
+  !> each process checks the values of its own points of a CSV file only ([[empm_bodies]]), so
+  !> that the earliest is the error one process reading every point meets first. Collective.
+  subroutine agree_first(comm, e, at)
+    type(empm_comm_t), intent(in) :: comm
+    type(empm_error_t), intent(inout) :: e
+    integer, intent(in) :: at(2)
+    integer :: b, l
+    if (.not. comm%parallel()) return
+    b = comm%min_int(merge(at(1), huge(1), e%code /= EMPM_OK))
+    l = comm%min_int(merge(at(2), huge(1), e%code /= EMPM_OK .and. at(1) == b))
+    if (e%code /= EMPM_OK .and. (at(1) /= b .or. at(2) /= l)) e = empm_error_t()
+    call comm%agree(e)
+  end subroutine agree_first
 
   !> Dealt out among processes (cs%deal), every process must have generated the same number of
   !> particles: a body file that differs between machines would otherwise give ids twice or
@@ -534,12 +552,14 @@ contains
     cs%shape_name = cs%model%shape%name()
   end subroutine read_shape
 
-  subroutine read_particles(path, gs, cs, ov, e)
+  subroutine read_particles(path, gs, cs, ov, e, at)
     character(len=*), intent(in) :: path
     type(empm_group_t), intent(in) :: gs(:)
     type(empm_case_t), intent(inout) :: cs
     type(empm_overrides_t), intent(in) :: ov
     type(empm_error_t), intent(inout) :: e
+    integer, intent(inout) :: at(2)   ! where an error was met ([[agree_first]]): the body,
+                                      ! and 0 before its file, the file's line, or huge after
     type(empm_param_t), allocatable :: p(:)
     type(empm_group_t) :: g
     character(len=:), allocatable :: material, geometry, placement, file
@@ -561,6 +581,7 @@ contains
       if (gs(k)%name /= 'particles') cycle
       g = gs(k)
       nbody = nbody + 1
+      at = [nbody, 0]
       call g%check_keys(p, e)
       bname = ''; geostatic = .false.; k0 = -1.0_wp
       call g%get(p(15), bname, e)
@@ -676,6 +697,7 @@ contains
       end do
       cs%body_last = [cs%body_last, cs%model%pts%np]
     end do
+    at = [nbody, huge(1)]
     if (nbody == 0) call missing_group(path, 'particles', e)
 
   contains
@@ -704,6 +726,7 @@ contains
       ! ones, in the file's order) are its own.
       call empm_read_body(full, nd, ppc, body, e, keep=[modulo(cs%deal%rank - cs%deal%n, &
         cs%deal%every), cs%deal%every])
+      at(2) = merge(e%line, huge(1), e%code /= EMPM_OK)
       if (e%code /= EMPM_OK) then
         ! The file's own location first, then the group that asked for it.
         e%message = e%message//' (&particles body '//str(nbody)//', '//path//':'// &

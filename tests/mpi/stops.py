@@ -15,7 +15,9 @@
    checkpoints gathered) stops the same way, with the serial run's message and last good state;
 5. a file the case needs that is missing on one process only (its own working folder, with
    mpirun's MPMD form) gives status 2 and one message naming the file, on every process; so
-   does a point list that differs between the processes' folders;
+   does a point list that differs between the processes' folders; a point list whose bad
+   values are met by different processes (each converts its own points' values) gives the
+   serial run's message, that of the earliest line;
 6. an output that one process cannot write (its file size limited) gives status 4 and one
    message naming the file, and leaves no partial file.
 No process may hang: each run has a time limit.
@@ -208,6 +210,28 @@ def main():
                      f"{log[-400:]}")
     else:
         print(f"ok   body files differing between processes: exit {rc}: {errs[0][:110]}")
+    # 3b. A point list with two bad values (points 6 and 7): each process converts the values
+    # of its own points only, so the earliest error (point 6, held by process 1 of 2 and 2 of
+    # 3) must win over the root's (point 7): the serial run's message, on every process.
+    pts = [f"{0.2 + 0.05 * i:.2f}, 0.35, 0.01" for i in range(12)]
+    pts[5] = "0.45, 0.35, -0.01"
+    pts[6] = "0.50, 0.35, abc"
+    (work / "F").mkdir(exist_ok=True)
+    (work / "F" / "pts.csv").write_text("x, y, volume\n" + "\n".join(pts) + "\n")
+    (work / "F" / "pts.nml").write_text(LEAVE.replace(
+        "geometry = 'box', lo = 0.2, 0.2, hi = 0.8, 0.8, ppc = 2",
+        "geometry = 'file', file = 'pts.csv'"))
+    rc, slog = run([empm, "run", "pts.nml", "-o", "s.h5"], work / "F")
+    serial_err = error_lines(slog)
+    if rc != 2 or len(serial_err) != 1 or ":7" not in serial_err[0]:
+        fails.append(f"csvbad: the serial run exited {rc}: {serial_err}")
+    for n in ranks:
+        rc, log = run(mpi + ["-n", str(n), empm, "run", "pts.nml", "-o", "p.h5"], work / "F")
+        errs = error_lines(log)
+        if rc != 2 or len(errs) != 1 or errs[0] != serial_err[0]:
+            fails.append(f"csvbad -n {n}: exit {rc}, messages {errs}, serial {serial_err}")
+        else:
+            print(f"ok   csvbad -n {n}: exit {rc}: {errs[0][:110]}")
     # 6. The output cannot be written by one process (its file size limited, as by a full
     # disk or a quota): status 4 on every process, one message naming the file and the reason,
     # no partial file left, no hang. Written together (parallel HDF5) the job ends there
