@@ -191,7 +191,9 @@ contains
     type(empm_output_meta_t) :: meta
     logical :: add0, shared
     type(empm_cpu_sample_t) :: load0
+    integer(int64) :: clock0, clock1, rate
 
+    call system_clock(clock0, rate)
     call empm_cpu_sample(load0)
     ! Shared among processes, each stores its share of the particles (a restart reads its
     ! share from the checkpoint), then its window of the grid and its basis.
@@ -283,11 +285,13 @@ contains
       end if
       call hist%locate_probes(cs%model%pts)
     end if
+    call system_clock(clock1)
     if (resumed) then
       call empm_solve(cs%model, cs%integ, cs%run, hist, e, stats, hook=hook, resume=sst)
     else
       call empm_solve(cs%model, cs%integ, cs%run, hist, e, stats, hook=hook)
     end if
+    if (present(stats)) stats%setup = real(clock1 - clock0, wp) / real(max(rate, 1_int64), wp)
 
     meta%case_file = path; meta%case_text = cs%text
     meta%shape = cs%shape_name; meta%integrator = cs%scheme_name
