@@ -10,12 +10,15 @@ a side, passes over it at 25 ns a node-step in 3D (`--node-pass-ns`), and exchan
 sums over the regions' overlaps) and the all-reduce of whole nodal arrays with every process
 passing over the whole grid, two designs before it.
 
-Usage: mpi_cost_model.py [--alpha-us 1.5] [--gbytes 12.5] [--node 0.78] [--imbalance 1.05]
-       [--node-pass-ns 25]
+Usage: mpi_cost_model.py [--alpha-us 1.5] [--gbytes 12.5] [--node-lme 0.85]
+       [--node-linear 0.77] [--imbalance 1.05] [--node-pass-ns 25]
   --alpha-us  message latency [us]; --gbytes link bandwidth [GB/s] (InfiniBand HDR100-class)
-  --node      a process's speed when every core of its node is busy, over its speed alone:
-              measured 0.78 for the 2D linear step (benchmarks/mpi_scaling.py, 2 processes on
-              this 2-core machine: memory bandwidth shared); a compute-bound LME step loses less
+  --node-lme, --node-linear
+              a process's speed when every core of its node is busy, over its speed alone,
+              measured by benchmarks/mpi_scaling.py (2 processes on this 2-core machine, weak,
+              2.6e5 particles each): the LME step, compute-bound, 0.85 in 3D (0.87 in 2D); the
+              linear step, bound by the memory bandwidth the cores share, 0.77 (STREAM triad:
+              two cores 1.23 times one)
   --imbalance the largest process's particles over the mean (measured 1.14-1.20 on small
               collapsing columns, tests/mpi/balance.py; the cut's grain shrinks with size)
 Two per-particle costs of one core, both measured (reports/performance.md): 3D LME gamma = 3
@@ -34,7 +37,9 @@ def opt(name, default):
 
 ALPHA = opt("--alpha-us", 1.5) * 1e-6       # s per message
 BETA = 1.0 / (opt("--gbytes", 12.5) * 1e9)  # s per byte
-NODE = opt("--node", 0.78)                  # on-node speed factor with every core busy
+NODE_LME = opt("--node-lme", 0.85)          # on-node speed factor with every core busy
+NODE_LINEAR = opt("--node-linear", 0.77)
+NODE = NODE_LME                             # set per table in main()
 IMB = opt("--imbalance", 1.05)              # largest process's share over the mean
 # The per-node passes (zeroing, divisions, constraints, the search for nearly-empty nodes,
 # the nodal screen), per node and step of pc_newmark: 3D, one process, a 100^3-cell grid
@@ -107,13 +112,15 @@ def table(title, rows):
 
 
 def main():
-    global COST, W, REACH
-    print(f"latency {ALPHA * 1e6:.1f} us, {1 / BETA / 1e9:.1f} GB/s; on-node factor {NODE}; "
-          f"imbalance {IMB}; {PPC} particles per cell\n")
+    global COST, W, REACH, NODE
+    print(f"latency {ALPHA * 1e6:.1f} us, {1 / BETA / 1e9:.1f} GB/s; on-node factor "
+          f"{NODE_LME} (LME), {NODE_LINEAR} (linear); imbalance {IMB}; {PPC} particles per "
+          f"cell\n")
     procs = [1, 2, 8, 64, 128, 256, 512, 1024]
     for label, cost, width in [("3D LME gamma = 3 (7.0 us a particle-step)", 7.0e-6, 3),
                                ("3D linear (0.25 us a particle-step)", 0.254e-6, 1)]:
         COST, W = cost, width
+        NODE = NODE_LME if width == 3 else NODE_LINEAR
         REACH = 3 if width == 3 else 0  # LME gamma = 3: ceil(R/h) = 3; linear: 0
         big = 1.0e8
         t_one = step_time(big, 1)[0]

@@ -7,8 +7,9 @@ process sent per step in the nodal sums ('halo ... bytes per step', the neighbou
 beside what an all-reduce of the whole nodal arrays (the design before it) would move.
 
 Usage: mpi_scaling.py EMPM MPIRUN WORKDIR [--cells 256] [--steps 60] [--rounds 3]
-       [--shape linear]
-Prints one line per run and a JSON line with the medians.
+       [--shape linear] [--dim 2]
+--cells is the 1-process block's cells a side (2 particles per direction and cell: 2.6e5
+particles at 256 in 2D, at 32 in 3D). Prints one line per run and a JSON line with the medians.
 """
 import json
 import math
@@ -44,14 +45,15 @@ def main():
     empm, mpirun, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
     cells, steps, rounds = opt("--cells", 256), opt("--steps", 60), opt("--rounds", 3)
     shape = opt("--shape", "linear")
+    dim = opt("--dim", 2)
     work.mkdir(parents=True, exist_ok=True)
-    # The same particles per process: the 2-process block has sqrt(2) times the cells a side.
-    cells2 = int(round(cells * math.sqrt(2.0)))
+    # The same particles per process: the 2-process block has 2^(1/dim) times the cells a side.
+    cells2 = int(round(cells * 2.0 ** (1.0 / dim)))
     cases = {}
     for n, c in ((1, cells), (2, cells2)):
         path = work / f"weak_{n}.nml"
-        subprocess.run(["/usr/bin/python3", str(HERE / "block_case.py"), str(path), "2", shape,
-                        str(c), "2", str(steps)], check=True)
+        subprocess.run(["/usr/bin/python3", str(HERE / "block_case.py"), str(path), str(dim),
+                        shape, str(c), "2", str(steps)], check=True)
         cases[n] = (path, c)
     env = dict(os.environ, OMP_NUM_THREADS="1")
     mpi = [mpirun] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
@@ -71,17 +73,22 @@ def main():
             times[n].append(t)
             if n > 1:
                 halo_bytes.append(halo(out.stdout + out.stderr))
-            npart = 4 * c * c
+            npart = (2 * c) ** dim
             print(f"round {r + 1}: {n} process(es), {npart} particles "
                   f"({npart // n} per process), time loop {t:.2f} s", flush=True)
     t1, t2 = statistics.median(times[1]), statistics.median(times[2])
-    # An all-reduce of the whole nodal arrays would move, per step of pc_newmark with linear
-    # shapes: masses, momenta (map_velocity) and forces (kick), (1 + 2 + 2) doubles per node.
-    nodes2 = (cells2 + 1) ** 2
-    sent = 8 * 5 * nodes2
-    print(json.dumps({"tag": "mpi_weak", "shape": shape, "particles_per_process": 4 * cells * cells,
+    # Efficiency per particle: the 2-process block holds a little more or fewer particles per
+    # process than the 1-process one (cells a side are whole numbers).
+    per1, per2 = (2 * cells) ** dim, (2 * cells2) ** dim / 2.0
+    eff = (t1 / per1) / (t2 / per2)
+    # An all-reduce of the whole nodal arrays would move, per step of pc_newmark: masses,
+    # momenta (map_velocity) and forces (kick), 1 + 2 dim doubles per node.
+    nodes2 = (cells2 + 1) ** dim
+    sent = 8 * (1 + 2 * dim) * nodes2
+    print(json.dumps({"tag": "mpi_weak", "shape": shape, "dim": dim,
+                      "particles_per_process": (2 * cells) ** dim,
                       "steps": steps, "t1_median": t1, "t2_median": t2,
-                      "efficiency": t1 / t2, "t1": times[1], "t2": times[2],
+                      "efficiency": eff, "t1": times[1], "t2": times[2],
                       "halo_bytes_per_step": statistics.median(halo_bytes),
                       "allreduce_bytes_per_step": sent}))
     return 0
