@@ -16,7 +16,8 @@ Usage: mpi_cost_model.py [--alpha-us 1.5] [--gbytes 12.5] [--node-lme 0.85]
   --node-lme, --node-linear
               a process's speed when every core of its node is busy, over its speed alone,
               measured by benchmarks/mpi_scaling.py (2 processes on this 2-core machine, weak,
-              2.6e5 particles each): the LME step, compute-bound, 0.85 in 3D (0.87 in 2D); the
+              2.6e5 particles each): the LME step, compute-bound, 0.85 (the lower of two 3D
+              runs, 0.85 and 0.89; 0.87 and 0.91 in 2D); the
               linear step, bound by the memory bandwidth the cores share, 0.77 (STREAM triad:
               two cores 1.23 times one)
   --imbalance the largest process's particles over the mean (measured 1.14-1.20 on small

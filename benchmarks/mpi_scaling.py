@@ -6,10 +6,10 @@ times ('wall ... s' of the summary line) give the efficiency T1/T2. Also the byt
 process sent per step in the nodal sums ('halo ... bytes per step', the neighbour exchange),
 beside what an all-reduce of the whole nodal arrays (the design before it) would move.
 
-Usage: mpi_scaling.py EMPM MPIRUN WORKDIR [--cells 256] [--steps 60] [--rounds 3]
+Usage: mpi_scaling.py EMPM MPIRUN WORKDIR [--cells 256 | 32] [--steps 60] [--rounds 3]
        [--shape linear] [--dim 2]
 --cells is the 1-process block's cells a side (2 particles per direction and cell: 2.6e5
-particles at 256 in 2D, at 32 in 3D). Prints one line per run and a JSON line with the medians.
+particles at the defaults, 256 in 2D and 32 in 3D). Prints one line per run and a JSON line with the medians.
 """
 import json
 import math
@@ -43,9 +43,10 @@ def halo(log):
 
 def main():
     empm, mpirun, work = sys.argv[1], sys.argv[2], pathlib.Path(sys.argv[3])
-    cells, steps, rounds = opt("--cells", 256), opt("--steps", 60), opt("--rounds", 3)
-    shape = opt("--shape", "linear")
     dim = opt("--dim", 2)
+    cells = opt("--cells", 256 if dim == 2 else 32)
+    steps, rounds = opt("--steps", 60), opt("--rounds", 3)
+    shape = opt("--shape", "linear")
     work.mkdir(parents=True, exist_ok=True)
     # The same particles per process: the 2-process block has 2^(1/dim) times the cells a side.
     cells2 = int(round(cells * 2.0 ** (1.0 / dim)))

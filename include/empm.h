@@ -60,8 +60,9 @@ int empm_run_case_file_comm(const char *path, const char *output, int fcomm, cha
 /* Before finalize: the model runs on the communicator's processes. Every process makes the
  * same calls and adds every particle; finalize gives each process those of its box. Called
  * before the first particle, each process stores only its share of them as they are added
- * (every P-th), and no nodal field of the whole grid; called later, every particle until
- * finalize (docs/embedding.md, "MPI"). Afterwards info, the
+ * (every P-th), and no nodal field of the whole grid, and its fields are read and set after
+ * finalize only; called later, every particle until finalize (docs/embedding.md, "MPI").
+ * Afterwards info, the
  * fields (get and set) and probe values are this process's particles, in the order they were
  * added (field "id": that number, from 1); steps, energies and write (the root writes every
  * particle) are collective: every process calls them. */

@@ -183,33 +183,37 @@ contains
     type(empm_capi_box_t), pointer, intent(in) :: b !! box
     integer, intent(in) :: handle                   !! the host's communicator
     type(empm_comm_t) :: comm
-    type(empm_error_t) :: e
     integer :: info
     rc = check_open(b, 'empm_model_set_comm', .true.)
     if (rc /= EMPM_OK) return
+    if (b%dealt .and. (b%deal%n > 0 .or. allocated(b%model%nodes%mass))) then
+      rc = fail(b, EMPM_ERR_USAGE, 'empm_model_set_comm: the model already has particles or '// &
+        'boundaries on a communicator (set it once, before them)'); return
+    end if
     call empm_comm_from_handle(handle, comm, info)
     if (info /= 0) then
       rc = fail(b, EMPM_ERR_USAGE, 'empm_model_set_comm: '//empm_comm_handle_problem(info))
       return
     end if
-    if (b%dealt) then
-      rc = fail(b, EMPM_ERR_USAGE, 'empm_model_set_comm: the model is already on a '// &
-        'communicator and has particles dealt out on it'); return
-    end if
     call b%model%comm%finish()
     b%model%comm = comm
     b%message = ''
-    if (comm%parallel() .and. b%model%pts%np == 0) then
+    b%dealt = .false.; b%deal%every = 1; b%deal%rank = 0
+    if (comm%parallel() .and. b%deal%n == 0) then
       b%dealt = .true.
       b%deal = empm_deal_t(every=comm%nranks, rank=comm%rank)
-      ! Boundaries set from now on are kept as lists (the windows come at finalize); set
-      ! before, they already hold the whole grid's fields, which finalize gives back.
-      if (.not. allocated(b%model%nodes%mass)) then
-        call b%model%nodes%alloc(b%model%grid, e, fields=.false.)
-        rc = remember(b, e)
-      end if
     end if
   end function capi_set_comm
+
+  !> A dealt model's nodes, before its first boundary or finalize: the boundaries are kept as
+  !> lists, without the whole grid's fields (the windows come at finalize). Boundaries set
+  !> before set_comm already hold the whole grid's fields, which finalize gives back.
+  subroutine dealt_nodes(b, e)
+    type(empm_capi_box_t), intent(inout) :: b !! box
+    type(empm_error_t), intent(inout) :: e    !! an allocation failure
+    if (b%dealt .and. .not. allocated(b%model%nodes%mass)) &
+      call b%model%nodes%alloc(b%model%grid, e, fields=.false.)
+  end subroutine dealt_nodes
 
   !> New handle from a case file (read with extra_groups='verify'), finalized and ready to step.
   integer function capi_from_case(path, h, msg) result(rc)
@@ -411,9 +415,14 @@ contains
     integer, intent(in) :: mask(3)                  !! nonzero: prescribe that component
     real(wp), intent(in) :: value(3)                !! prescribed velocity [m/s]
     integer, intent(out) :: nsel                    !! nodes selected
+    type(empm_error_t) :: e
     nsel = 0
     rc = check_open(b, 'empm_model_fix_box', .true.)
     if (rc /= EMPM_OK) return
+    call dealt_nodes(b, e)
+    if (e%code /= EMPM_OK) then
+      rc = remember(b, e); return
+    end if
     call b%model%nodes%fix_box(b%model%grid, lo, hi, mask /= 0, value, nsel)
     b%message = ''
   end function capi_fix_box
@@ -444,6 +453,7 @@ contains
     real(wp), intent(in) :: delta                   !! friction angle [deg], in [0, 90)
     integer, intent(out) :: nsel                    !! nodes selected
     character(len=*), parameter :: WHAT = 'empm_model_friction_box: '
+    type(empm_error_t) :: e
     integer :: info
     nsel = 0
     rc = check_open(b, 'empm_model_friction_box', .true.)
@@ -455,6 +465,10 @@ contains
     if (.not. (delta >= 0.0_wp .and. delta < 90.0_wp)) then
       rc = fail(b, EMPM_ERR_USAGE, WHAT//'the friction angle must be in [0, 90) degrees, got '// &
         str(delta)); return
+    end if
+    call dealt_nodes(b, e)
+    if (e%code /= EMPM_OK) then
+      rc = remember(b, e); return
     end if
     call b%model%nodes%friction_box(b%model%grid, lo, hi, normal, tan(delta * pi / 180.0_wp), &
                                     nsel, info)
@@ -487,7 +501,9 @@ contains
     type(empm_error_t) :: e
     rc = check_open(b, 'empm_model_finalize', .true.)
     if (rc /= EMPM_OK) return
-    if (b%nmat == 0 .or. b%deal%n == 0) then
+    ! On a communicator every process must pass the checks below or none (the collective
+    ! steps after them): a process whose calls were refused fails them for all.
+    if (b%model%comm%min_int(merge(1, 0, b%nmat > 0 .and. b%deal%n > 0)) == 0) then
       rc = fail(b, EMPM_ERR_USAGE, 'empm_model_finalize: add materials and particles first')
       return
     end if
@@ -507,7 +523,10 @@ contains
       rc = fail(b, EMPM_ERR_USAGE, 'empm_model_finalize: integrator '''//b%integ%family()// &
         ''' does not support frictional walls ('//WALL_SCHEMES//' do)'); return
     end if
-    call b%model%finalize_setup(e, shared=b%dealt)
+    call dealt_nodes(b, e)
+    if (e%code == EMPM_OK) call b%model%finalize_setup(e, shared=b%dealt)
+    ! An error one process met (its memory) is everyone's before the collective steps.
+    call b%model%comm%agree(e)
     if (e%code == EMPM_OK .and. b%model%comm%parallel()) then
       ! Every process added every particle: each keeps, or is sent, those of its box.
       if (b%model%comm%min_int(b%deal%n) /= b%model%comm%max_int(b%deal%n)) then
@@ -569,6 +588,13 @@ contains
     n = 0; ncomp = 0; row = 0
     rc = EMPM_ERR_USAGE
     if (.not. associated(b)) return
+    if (b%dealt .and. .not. b%ready) then
+      ! Each process holds only its share of the particles added, until finalize sends each
+      ! to the process of its box: fields by index would mean other particles there.
+      rc = fail(b, EMPM_ERR_USAGE, 'particle field "'//field//'": the model''s particles are '// &
+        'dealt out on its communicator; read and set fields after empm_model_finalize, each '// &
+        'process its own particles (field "id" names them)'); return
+    end if
     select case (field)
     case ('x', 'v')
       ncomp = b%model%grid%ndim

@@ -212,8 +212,9 @@ contains
     end do
     close(u)
     if (ios > 0) then
+      ! At the line it could not read: the processes agree on the earliest line.
       call err%set(EMPM_ERR_INPUT, 'cannot read the point list after line '//str(lnum)// &
-        ': '//trim(rd%msg), file=path); return
+        ': '//trim(rd%msg), file=path, line=lnum + 1); return
     end if
     if (.not. header_done) then
       call err%set(EMPM_ERR_INPUT, 'empty point list: expected a header line naming the '// &

@@ -617,7 +617,8 @@ contains
     ex = 0
     m = 0   ! where the exponent's letter goes in the C text (one without a letter)
     if (i <= e) then
-      ! The exponent: a letter and a sign, or a sign, then at most 5 digits.
+      ! The exponent: a letter and a sign, or a sign, then digits (at most 9 after leading
+      ! zeros: beyond, a magnitude is too big, or below any double's, anyway).
       if (index('eEdD', t(i:i)) > 0) then
         i = i + 1
       else if (t(i:i) == '+' .or. t(i:i) == '-') then
@@ -632,8 +633,12 @@ contains
           i = i + 1
         end if
       end if
-      if (i > e .or. e - i + 1 > 5) return
+      if (i > e) return
       if (verify(t(i:e), '0123456789') > 0) return
+      do while (i < e .and. t(i:i) == '0')
+        i = i + 1
+      end do
+      if (e - i + 1 > 9) return
       do n = i, e
         ex = 10 * ex + (iachar(t(n:n)) - iachar('0'))
       end do

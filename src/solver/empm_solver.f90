@@ -89,7 +89,8 @@ module empm_solver
     real(wp) :: wall = 0.0_wp           !! wall-clock time of the time loop [s]
     real(wp) :: setup = -1.0_wp         !! wall-clock time before it [s] (the driver's: reading
                                         !! the case, sharing the particles, claiming the
-                                        !! output); < 0: not measured (empm_solve alone)
+                                        !! output, the first basis; the slowest process's);
+                                        !! < 0: not measured (empm_solve alone)
     real(wp) :: t_start = 0.0_wp        !! time at the start [s]
     real(wp) :: t_reached = 0.0_wp      !! time reached [s]
     real(wp) :: energy_initial = 0.0_wp !! total energy (kinetic + strain + gravity) at the start [J]

@@ -147,7 +147,7 @@ static void compare(empm_model *serial, empm_model *par, const char *label, int 
 
 int main(int argc, char **argv)
 {
-  int rank, nranks, rc, order;
+  int rank, nranks, rc, order, k;
   long held[2], most[2];
   char msg[512], path[1024];
   empm_model *serial, *par[2], *late;
@@ -197,6 +197,37 @@ int main(int argc, char **argv)
     CHECK(empm_model_create(1, origin, h, ncell, &late, msg, sizeof msg) == EMPM_OK);
     CHECK(empm_model_set_comm(late, (int)MPI_Comm_c2f(MPI_COMM_NULL)) == EMPM_ERR_USAGE);
     CHECK(empm_model_error(late, msg, sizeof msg) == EMPM_OK && strstr(msg, "MPI_COMM_NULL"));
+    empm_model_destroy(late);
+  }
+  /* A dealt model: set_comm again before its particles (accepted), after them (refused);
+   * fields before finalize (refused, saying why); a particle refused on one process only
+   * (outside the grid there): finalize fails on every process, none waits. */
+  {
+    double origin[1] = {0}, h[1] = {1}, x[4] = {0.5, 1.5, 2.5, 3.5}, vol[4] = {1, 1, 1, 1};
+    double rho[4] = {1, 1, 1, 1}, v[4] = {0, 0, 0, 0};
+    int ncell[1] = {4}, mat[4] = {0, 0, 0, 0}, imat = 0, refused;
+    size_t n;
+    CHECK(empm_model_create(1, origin, h, ncell, &late, msg, sizeof msg) == EMPM_OK);
+    CHECK(empm_model_set_comm(late, (int)MPI_Comm_c2f(MPI_COMM_WORLD)) == EMPM_OK);
+    CHECK(empm_model_set_comm(late, (int)MPI_Comm_c2f(MPI_COMM_WORLD)) == EMPM_OK);
+    CHECK(empm_model_add_material(late, "linear_elastic", "E = 100, nu = 0, density = 1",
+                                  &imat) == EMPM_OK);
+    for (k = 0; k < 4; k++) mat[k] = imat;
+    CHECK(empm_model_add_particles(late, 4, x, vol, rho, mat) == EMPM_OK);
+    CHECK(empm_model_set_comm(late, (int)MPI_Comm_c2f(MPI_COMM_WORLD)) == EMPM_ERR_USAGE);
+    CHECK(empm_model_field_size(late, "v", &n) == EMPM_ERR_USAGE);
+    CHECK(empm_model_set_field(late, "v", v, 4) == EMPM_ERR_USAGE);
+    CHECK(empm_model_error(late, msg, sizeof msg) == EMPM_OK && strstr(msg, "after empm_model_finalize"));
+    CHECK(empm_model_finalize(late) == EMPM_OK);
+    empm_model_destroy(late);
+    CHECK(empm_model_create(1, origin, h, ncell, &late, msg, sizeof msg) == EMPM_OK);
+    CHECK(empm_model_set_comm(late, (int)MPI_Comm_c2f(MPI_COMM_WORLD)) == EMPM_OK);
+    CHECK(empm_model_add_material(late, "linear_elastic", "E = 100, nu = 0, density = 1",
+                                  &imat) == EMPM_OK);
+    if (rank == nranks - 1) x[3] = 9.5;
+    refused = empm_model_add_particles(late, 4, x, vol, rho, mat) != EMPM_OK;
+    CHECK(refused == (rank == nranks - 1));
+    CHECK(empm_model_finalize(late) == EMPM_ERR_USAGE);
     empm_model_destroy(late);
   }
   empm_model_destroy(serial);
