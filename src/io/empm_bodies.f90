@@ -11,7 +11,9 @@
 !> A CSV file's lines are all read and their values counted everywhere, but each process
 !> converts and checks the values of its own points only: the conversion is the reading's
 !> cost. Its error is then the first in the file of those it has: the caller agrees on the
-!> earliest line over the processes, which is the error a single process would give.
+!> earliest line over the processes, which is the error a single process would give. A Gmsh
+!> mesh is read whole by every process (its text, nodes and elements, every element checked),
+!> which stores its share of the quadrature points only.
 module empm_bodies
   use, intrinsic :: ieee_arithmetic, only: ieee_is_finite
   use, intrinsic :: iso_fortran_env, only: int64
@@ -82,11 +84,10 @@ contains
     case ('h5', 'hdf5')
       call read_hdf5(path, ndim, kp, body, err)
     case ('msh')
-      ! A mesh's quadrature points are made whole, then kept.
-      call empm_gmsh_points(path, ndim, order, body%x, body%vol, err)
+      ! Every element read and checked, only the kept quadrature points stored.
+      call empm_gmsh_points(path, ndim, order, body%x, body%vol, err, keep=kp, &
+                            total=body%total)
       if (err%code /= EMPM_OK) return
-      body%total = size(body%vol)
-      body%x = body%x(:, kp(1) + 1::kp(2)); body%vol = body%vol(kp(1) + 1::kp(2))
       body%n = size(body%vol)
       allocate(body%v(ndim, body%n), body%stress(6, body%n))
       body%v = 0.0_wp; body%stress = 0.0_wp

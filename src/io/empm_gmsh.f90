@@ -52,13 +52,19 @@ module empm_gmsh
 contains
 
   !> Read the Gmsh 4.1 ASCII mesh `path` and return its quadrature points in `ndim` dimensions.
-  subroutine empm_gmsh_points(path, ndim, order, x, vol, err)
+  !> With `keep`, only every stride-th point is stored (a process's share when the body is
+  !> dealt out among processes); every element is still read and checked.
+  subroutine empm_gmsh_points(path, ndim, order, x, vol, err, keep, total)
     character(len=*), intent(in) :: path            !! .msh file
     integer, intent(in) :: ndim                     !! body dimension (1..3)
     integer, intent(in) :: order                    !! quadrature order per direction (1..4)
     real(wp), allocatable, intent(out) :: x(:,:)    !! particle positions (ndim, n) [m]
     real(wp), allocatable, intent(out) :: vol(:)    !! particle volumes (n) [m^ndim]
     type(empm_error_t), intent(inout) :: err        !! set on a malformed file
+    integer, intent(in), optional :: keep(2)        !! (first, stride): store points first + 1,
+                                                    !! first + 1 + stride, ... only (first
+                                                    !! 0-based); default all
+    integer, intent(out), optional :: total         !! points of the mesh (stored or not)
     type(lines_t) :: f
     type(empm_error_t) :: e
     integer(int64), allocatable :: tags(:)
@@ -66,14 +72,17 @@ contains
     real(wp), allocatable :: xyz(:,:)
     logical :: have_format, have_nodes, have_elems
     character(len=:), allocatable :: ln
-    integer :: np
+    integer :: np, nall, kp(2)
+    kp = [0, 1]
+    if (present(keep)) kp = keep
+    if (present(total)) total = 0
     call empm_read_text(path, f%text, e)
     if (e%code /= EMPM_OK) then
       call err%set(EMPM_ERR_INPUT, 'cannot read the mesh: '//e%message, file=path); return
     end if
     call split_lines(f)
     have_format = .false.; have_nodes = .false.; have_elems = .false.
-    np = 0
+    np = 0; nall = 0
     allocate(x(ndim, 64), vol(64))
     do while (f%cur < f%n)
       f%cur = f%cur + 1
@@ -107,11 +116,12 @@ contains
       call err%set(EMPM_ERR_INPUT, 'missing section '//merge('$Nodes   ', '$Elements', &
         .not. have_nodes), file=path); return
     end if
-    if (np == 0) then
+    if (nall == 0) then
       call err%set(EMPM_ERR_INPUT, 'the mesh has no '//str(ndim)//'-D element (types '// &
         supported(ndim)//')', file=path); return
     end if
     x = x(:, 1:np); vol = vol(1:np)
+    if (present(total)) total = nall
 
   contains
 
@@ -333,7 +343,7 @@ contains
       integer, intent(in) :: tag
       real(wp) :: xq(3, 64), wq(64)
       real(wp), allocatable :: tx(:,:), tv(:)
-      integer :: nq, info
+      integer :: nq, info, q, k
       call element_points(etype, xe, order, xq, wq, nq, info)
       if (info /= 0) then
         call fail('element '//str(tag)//' ('//empm_gmsh_type_name(etype)//') is '//trim( &
@@ -345,9 +355,13 @@ contains
         tx(:, 1:np) = x(:, 1:np); tv(1:np) = vol(1:np)
         call move_alloc(tx, x); call move_alloc(tv, vol)
       end if
-      x(:, np + 1:np + nq) = xq(1:ndim, 1:nq)
-      vol(np + 1:np + nq) = wq(1:nq)
-      np = np + nq
+      do q = 1, nq
+        k = nall + q - 1 ! the point's 0-based number in the mesh
+        if (k < kp(1) .or. mod(k - kp(1), kp(2)) /= 0) cycle
+        np = np + 1
+        x(:, np) = xq(1:ndim, q); vol(np) = wq(q)
+      end do
+      nall = nall + nq
     end subroutine add_element
   end subroutine empm_gmsh_points
 

@@ -230,7 +230,8 @@ CASES = {
 """,
     # 2D: the set-up of a case shared among processes, each storing its share of the generated
     # particles (docs/parallel.md, "Set-up"): a geostatic box and a geostatic disk (whose
-    # columns' tops every process must agree on), a body read from a point list, a traction
+    # columns' tops every process must agree on), a body read from a point list and one from a
+    # Gmsh mesh (each process storing its share of their points), a traction
     # and a mirror checked against every process's particles, a probe at the point nearest
     # to a position and one by particle number. The slab slides across the processes' boxes.
     "dealt2d": """&grid
@@ -252,6 +253,9 @@ CASES = {
 /
 &particles
   name = 'bricks', material = 'rock', geometry = 'file', file = 'dealt2d_points.csv'
+/
+&particles
+  name = 'pebbles', material = 'rock', geometry = 'file', file = 'dealt2d_mesh.msh', ppc = 2
 /
 &shape
   family = '{shape}' {shape_keys}
@@ -285,6 +289,16 @@ CASES = {
 DEALT_POINTS = "x, y, volume, vx\n" + "".join(
     f"{2.425 + 0.05 * i:.3f}, {0.525 + 0.05 * j:.3f}, 0.0025, -0.2\n"
     for j in range(3) for i in range(4))
+
+# dealt2d's fourth body: a Gmsh 4.1 mesh of 3 x 2 quadrangles of 5 cm above the slab.
+DEALT_MESH = ("$MeshFormat\n4.1 0 8\n$EndMeshFormat\n$Nodes\n1 12 1 12\n2 1 0 12\n"
+              + "".join(f"{k + 1}\n" for k in range(12))
+              + "".join(f"{1.8 + 0.05 * i:.2f} {0.5 + 0.05 * j:.2f} 0\n"
+                        for j in range(3) for i in range(4))
+              + "$EndNodes\n$Elements\n1 6 1 6\n2 1 3 6\n"
+              + "".join(f"{3 * j + i + 1} {4 * j + i + 1} {4 * j + i + 2} {4 * j + i + 6} "
+                        f"{4 * j + i + 5}\n" for j in range(2) for i in range(3))
+              + "$EndElements\n")
 
 # Per case: end time and snapshot times (the disks meet at t = 1.6 s and part again; the
 # block stops at 0.57 s).
@@ -386,6 +400,7 @@ def main():
     combos = [c for c in combos if c[0] != "dealt2d" or
               (c[1] in ("musl", "pc_newmark") and c[2] in ("ugimp", "lme"))]
     (work / "dealt2d_points.csv").write_text(DEALT_POINTS)
+    (work / "dealt2d_mesh.msh").write_text(DEALT_MESH)
     if not lib.exists():
         combos = [c for c in combos if c[0] != "umat2d"]
         env_note.append(f"umat2d skipped: no {lib}")
