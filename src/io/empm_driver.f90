@@ -10,7 +10,8 @@ module empm_driver
   use empm_history, only: empm_history_t, empm_snapshot_t
   use empm_solver, only: empm_solve, empm_run_stats_t, empm_run_hook_t, empm_solver_state_t
   use empm_output, only: empm_write_results, empm_output_meta_t, empm_output_claim, &
-    empm_output_release, empm_write_snapshot_file, empm_staging_path
+    empm_output_release, empm_write_snapshot_file, empm_staging_path, empm_xdmf_path, &
+    empm_remove_stale_partials
   use empm_files, only: empm_mkdir_p, empm_remove, empm_rmdir
   use empm_checkpoint, only: empm_checkpoint_write, empm_checkpoint_read, empm_checkpoint_path
   use empm_posix, only: empm_stop_signal, empm_sleep, empm_errno, empm_errno_text
@@ -192,6 +193,7 @@ contains
     logical :: add0, shared
     type(empm_cpu_sample_t) :: load0
     integer(int64) :: clock0, clock1, rate
+    character(len=:), allocatable :: own(:), folder(:)
 
     call system_clock(clock0, rate)
     call empm_cpu_sample(load0)
@@ -240,6 +242,14 @@ contains
     if (cs%model%comm%is_root()) then
       call empm_output_claim(cs%output_file, e)
       if (e%code == EMPM_OK) then
+        ! What a killed run of this output was writing (its snapshots are kept: a restart
+        ! may need them).
+        allocate(character(len=len(cs%output_file) + 16) :: own(4), folder(1))
+        own(1) = cs%output_file; own(2) = empm_xdmf_path(cs%output_file)
+        own(3) = empm_checkpoint_path(cs%output_file)
+        own(4) = empm_checkpoint_path(cs%output_file, prev=.true.)
+        folder(1) = hook%staging
+        call empm_remove_stale_partials(own, folder)
         if (empm_mkdir_p(hook%staging) /= 0) then
           call e%set(EMPM_ERR_IO, cs%output_file//': cannot create the folder '// &
             hook%staging//' for its snapshots: '//empm_errno_text(empm_errno()))

@@ -34,7 +34,7 @@ module empm_output
   use empm_error, only: empm_error_t, empm_raise, EMPM_ERR_IO, EMPM_ERR_INPUT
   use empm_files, only: empm_rename, empm_remove
   use empm_posix, only: empm_getpid, empm_process_alive, empm_path_kind, empm_errno, &
-    empm_errno_text, empm_write_reason, PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY
+    empm_errno_text, empm_write_reason, empm_glob, PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY
   use empm_version_info, only: empm_version
   use empm_strings, only: str
   use empm_model, only: empm_model_t
@@ -46,6 +46,7 @@ module empm_output
   private
   public :: empm_write_results, empm_output_meta_t, empm_xdmf_path
   public :: empm_output_claim, empm_output_release, empm_partial_name, empm_shared_file_t
+  public :: empm_remove_stale_partials
   public :: empm_write_snapshot_file, empm_staging_path, empm_frame_header
 
   !> An HDF5 file written by the processes of a run: together (parallel HDF5, each process
@@ -648,6 +649,56 @@ contains
     !$omp end atomic
     tmp = path//'.'//itoa(empm_getpid())//'-'//itoa(n)//'.partial'
   end function empm_partial_name
+
+  !> Remove the partial files a killed writer left (`[[empm_partial_name]]`: `F.<pid>-<n>.partial`
+  !> whose process no longer exists): beside each of `files`, and in each of `folders`. A live
+  !> process's partial file, and any other file, is left alone. Called by the run that holds an
+  !> output's lock, for the output's files and its snapshots' folder: a killed run's
+  !> partial snapshot may be as large as a snapshot.
+  subroutine empm_remove_stale_partials(files, folders)
+    character(len=*), intent(in) :: files(:)   !! files whose partial names are looked for
+    character(len=*), intent(in) :: folders(:) !! folders whose partial files are looked for
+    character(len=4096), allocatable :: names(:)
+    integer :: k, j, info
+    do k = 1, size(files) + size(folders)
+      if (k <= size(files)) then
+        call empm_glob(glob_literal(trim(files(k)))//'.*.partial', names)
+      else
+        call empm_glob(glob_literal(trim(folders(k - size(files))))//'/*.partial', names)
+      end if
+      do j = 1, size(names)
+        ! (A file that cannot be removed stays: it harms nothing.)
+        if (stale(trim(names(j)))) info = empm_remove(trim(names(j)))
+      end do
+    end do
+  contains
+    ! `name` is NAME.<pid>-<n>.partial of a process that no longer exists.
+    logical function stale(name)
+      character(len=*), intent(in) :: name
+      integer :: b, d, pid, ios
+      stale = .false.
+      b = index(name(1:len(name) - len('.partial')), '.', back=.true.)
+      if (b == 0) return
+      d = index(name(b + 1:), '-')
+      if (d <= 1) return
+      if (verify(name(b + 1:b + d - 1), '0123456789') /= 0) return
+      read(name(b + 1:b + d - 1), *, iostat=ios) pid
+      if (ios /= 0) return
+      stale = .not. empm_process_alive(pid)
+    end function stale
+  end subroutine empm_remove_stale_partials
+
+  ! `path` with the shell pattern characters escaped: matched literally by empm_glob.
+  pure function glob_literal(path) result(s)
+    character(len=*), intent(in) :: path
+    character(len=:), allocatable :: s
+    integer :: i
+    s = ''
+    do i = 1, len(path)
+      if (index('*?[]'//achar(92), path(i:i)) > 0) s = s//achar(92) ! a backslash
+      s = s//path(i:i)
+    end do
+  end function glob_literal
 
   !> Before a run: check that `path` can be an output (absent or a regular file; a folder or a
   !> device is refused, EMPM_ERR_INPUT naming it) and take its lock `path.lock` (EMPM_ERR_IO

@@ -2,16 +2,18 @@
 !> through C interoperability): the process id and whether a process is alive (output locks),
 !> the kind of an existing path (an output must be a regular file), the text of `errno` (the
 !> reason of a failed write), ignoring SIGXFSZ (so that exceeding the file-size limit is a
-!> failed write, reported, not a killed process) and a short sleep (the thread choice of
-!> `empm run` measuring the machine's load).
+!> failed write, reported, not a killed process), a short sleep (the thread choice of
+!> `empm run` measuring the machine's load) and the files matching a pattern (glob: a killed
+!> run's partial files).
 module empm_posix
   use, intrinsic :: iso_c_binding, only: c_int, c_char, c_null_char, c_ptr, c_funptr, &
-    c_intptr_t, c_f_pointer, c_associated, c_int16_t, c_funloc
+    c_intptr_t, c_f_pointer, c_associated, c_int16_t, c_funloc, c_null_funptr, c_null_ptr, &
+    c_size_t
   implicit none
   private
   public :: empm_getpid, empm_process_alive, empm_path_kind, empm_errno, empm_errno_text, &
             empm_ignore_sigxfsz, empm_catch_stop_signals, empm_stop_signal, empm_write_reason, &
-            empm_sleep
+            empm_sleep, empm_glob
   public :: PATH_MISSING, PATH_REGULAR, PATH_DIRECTORY, PATH_OTHER
 
   integer, parameter :: PATH_MISSING = 0   !! nothing at the path (or it cannot be examined)
@@ -56,6 +58,25 @@ module empm_posix
       type(c_funptr), value :: handler
       type(c_funptr) :: old
     end function c_signal
+    ! glob_t is passed as the address of a buffer larger than glibc's (72 bytes on 64-bit
+    ! Linux), whose first two members are size_t gl_pathc and char **gl_pathv.
+    function c_glob(pattern, flags, errfunc, pglob) bind(C, name='glob') result(r)
+      import :: c_char, c_int, c_funptr, c_ptr
+      character(kind=c_char), intent(in) :: pattern(*)
+      integer(c_int), value :: flags
+      type(c_funptr), value :: errfunc
+      type(c_ptr), intent(inout) :: pglob(16)
+      integer(c_int) :: r
+    end function c_glob
+    subroutine c_globfree(pglob) bind(C, name='globfree')
+      import :: c_ptr
+      type(c_ptr), intent(inout) :: pglob(16)
+    end subroutine c_globfree
+    function c_strlen(s) bind(C, name='strlen') result(n)
+      import :: c_ptr, c_size_t
+      type(c_ptr), value :: s
+      integer(c_size_t) :: n
+    end function c_strlen
   end interface
 
   ! Linux constants (the same on every architecture gfortran targets there except MIPS/SPARC,
@@ -76,6 +97,37 @@ contains
     integer(c_int) :: r
     r = c_usleep(int(max(0.0, min(1.0, seconds)) * 1.0e6, c_int))
   end subroutine empm_sleep
+
+  !> The paths matching the shell pattern `pattern` (`*`, `?`, `[...]`; a metacharacter of a
+  !> literal part escaped with `\`), sorted; none when nothing matches or the search fails.
+  subroutine empm_glob(pattern, names)
+    character(len=*), intent(in) :: pattern                   !! shell pattern
+    character(len=4096), allocatable, intent(out) :: names(:) !! matching paths
+    type(c_ptr) :: g(16)
+    type(c_ptr), pointer :: pathv(:)
+    character(kind=c_char), pointer :: chars(:)
+    integer(c_intptr_t) :: npath
+    integer :: k, j, n
+    g = c_null_ptr
+    allocate(names(0))
+    if (c_glob(pattern//c_null_char, 0_c_int, c_null_funptr, g) == 0) then
+      npath = transfer(g(1), npath)
+      if (npath > 0 .and. c_associated(g(2))) then
+        call c_f_pointer(g(2), pathv, [int(npath)])
+        deallocate(names)
+        allocate(names(int(npath)))
+        do k = 1, int(npath)
+          n = int(min(c_strlen(pathv(k)), int(len(names), c_size_t)))
+          call c_f_pointer(pathv(k), chars, [n])
+          names(k) = ''
+          do j = 1, n
+            names(k)(j:j) = chars(j)
+          end do
+        end do
+      end if
+    end if
+    call c_globfree(g)
+  end subroutine empm_glob
 
   !> The id of this process.
   integer function empm_getpid() result(pid)

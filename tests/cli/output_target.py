@@ -5,7 +5,10 @@
               naming the other process), and so is one on -o OUT without .h5 (the same
               XDMF file and checkpoints); the first completes (status 0, a complete file
               with non-zero data); no partial or lock file is left.
-  stale_lock  a lock left by a killed run (a dead process id) is taken over (status 0).
+  stale_lock  a lock left by a killed run (a dead process id) is taken over (status 0), and
+              the partial files it left (beside the output, its XDMF file and checkpoints,
+              and in its snapshots' folder) are removed; a live process's partial file, and
+              a file that is not a partial name, are left.
   fifo        an existing non-regular file (a FIFO) as -o: refused (status 2, naming it),
               left as it was.
   directory   a folder as -o: refused (status 2), no partial or XDMF file left.
@@ -106,10 +109,26 @@ def stale_lock(empm, cases, work):
     dead.wait()  # its id is no longer a process (reuse within the test is improbable)
     with open(os.path.join(work, "stale.h5.lock"), "w") as f:
         f.write(f"{dead.pid}\n")
+    os.makedirs(os.path.join(work, "stale.h5.snapshots"))
+    dead_files = [f"stale.h5.{dead.pid}-1.partial", f"stale.xmf.{dead.pid}-2.partial",
+                  f"stale.ckpt.h5.{dead.pid}-3.partial",
+                  f"stale.ckpt.prev.h5.{dead.pid}-5.partial",
+                  f"stale.h5.snapshots/000001.h5.{dead.pid}-4.partial"]
+    kept = [f"stale.h5.{os.getpid()}-9.partial", "stale.h5.notes.partial"]
+    for name in dead_files + kept:
+        with open(os.path.join(work, name), "w") as f:
+            f.write("x" * 1000)
     p = run(empm, [os.path.join(cases, "good.nml"), "-o", "stale.h5"], work)
     if p.returncode != 0:
         fail(f"status {p.returncode}, expected 0 (stale lock taken over)")
     check_complete(os.path.join(work, "stale.h5"))
+    left = [n for n in dead_files if os.path.exists(os.path.join(work, n))]
+    if left or os.path.exists(os.path.join(work, "stale.h5.snapshots")):
+        fail(f"a killed run's partial files left behind: {left}")
+    if not all(os.path.exists(os.path.join(work, n)) for n in kept):
+        fail(f"removed a live process's partial file or another file: {kept}")
+    for name in kept:
+        os.remove(os.path.join(work, name))
     if leftovers(work):
         fail(f"left behind: {leftovers(work)}")
     # A lock held by a live process (this script) is respected.

@@ -15,7 +15,7 @@ import subprocess
 import sys
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parent))
-from same_answers import case_text, compare, DEALT_POINTS  # noqa: E402
+from same_answers import case_text, compare, write_body_files  # noqa: E402
 
 TOL = 1.0e-12
 
@@ -25,7 +25,7 @@ def main():
     work.mkdir(parents=True, exist_ok=True)
     mpi = [mpirun, "--oversubscribe"] + (["--allow-run-as-root"] if os.geteuid() == 0 else [])
     fails = []
-    (work / "dealt2d_points.csv").write_text(DEALT_POINTS)
+    write_body_files(work)
 
     def run(n, args):
         cmd = [empm, "run"] + args

@@ -315,6 +315,12 @@ SHAPES = {"linear": "", "ugimp": "", "bspline2": "", "lme": ", gamma = 1.8"}
 UMAT_LIB = ""  # set in main: the probe UMAT built beside empm (tests/umat)
 
 
+def write_body_files(work):
+    """The files dealt2d's bodies are read from, into the runs' folder."""
+    (work / "dealt2d_points.csv").write_text(DEALT_POINTS)
+    (work / "dealt2d_mesh.msh").write_text(DEALT_MESH)
+
+
 def case_text(name, scheme, shape):
     t_end, snap = TIMES[name]
     return CASES[name].format(scheme=scheme, shape=shape, shape_keys=SHAPES[shape],
@@ -399,8 +405,7 @@ def main():
     combos = [c for c in combos if c[0] != "drift2d" or c[2] != "linear"]
     combos = [c for c in combos if c[0] != "dealt2d" or
               (c[1] in ("musl", "pc_newmark") and c[2] in ("ugimp", "lme"))]
-    (work / "dealt2d_points.csv").write_text(DEALT_POINTS)
-    (work / "dealt2d_mesh.msh").write_text(DEALT_MESH)
+    write_body_files(work)
     if not lib.exists():
         combos = [c for c in combos if c[0] != "umat2d"]
         env_note.append(f"umat2d skipped: no {lib}")
