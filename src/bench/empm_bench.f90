@@ -91,6 +91,8 @@ module empm_bench
     real(wp) :: seconds = 0.0_wp                        !! wall time of the timed steps [s]
     real(wp) :: particle_steps_per_second = 0.0_wp      !! particles × steps / seconds
     real(wp) :: newton_iterations_mean = 0.0_wp         !! per particle-step (LME; else 0)
+    real(wp) :: travel_cells = 0.0_wp                   !! mean distance a particle moved over
+                                                        !! the timed steps, in cells (sampled)
     real(wp) :: bytes_per_particle = 0.0_wp             !! (peak RSS − baseline) / particles
     real(wp) :: phase_seconds(PHASE_COUNT) = 0.0_wp     !! shape, p2g, grid, g2p, stress [s]
     real(wp) :: checksum = 0.0_wp                       !! Σ|x| + Σ|v|/v0 + Σ|σ|/E at the end
@@ -242,8 +244,8 @@ contains
     type(empm_error_t), intent(inout), optional :: err   !! a failed step
     type(empm_step_status_t) :: stat
     integer(int64) :: rss1, c0, c1, rate, ticks, nchanged
-    real(wp), allocatable :: state0(:,:)
-    integer :: k
+    real(wp), allocatable :: state0(:,:), x0(:,:)
+    integer :: k, stride
 
     do k = 1, cfg%warmup
       call advance()
@@ -252,6 +254,10 @@ contains
     call integ%timer%reset()
     ticks = 0; nchanged = 0
     if (model%pts%nstate > 0) allocate(state0(model%pts%nstate, model%pts%np))
+    ! The distance travelled, on at most ~1024 particles (a copy of every position would add to
+    ! the peak memory that `bytes_per_particle` reports).
+    stride = max(1, model%pts%np / 1024)
+    x0 = model%pts%x(:, 1:model%pts%np:stride)
     do k = 1, cfg%steps
       if (allocated(state0)) state0 = model%pts%state(:, 1:model%pts%np)
       call system_clock(c0, rate)
@@ -278,6 +284,8 @@ contains
       real(integ%timer%newton_iters, wp) / real(integ%timer%basis_evals, wp)
     if (rss0 > 0 .and. rss1 > 0) res%bytes_per_particle = real(rss1 - rss0, wp) / res%particles
     res%phase_seconds = integ%timer%seconds
+    if (size(x0, 2) > 0) res%travel_cells = sum(sqrt(sum((model%pts%x(:, 1:model%pts%np:stride) &
+      - x0)**2, dim=1))) / (size(x0, 2) * model%grid%hmin())
     associate (np => model%pts%np)
       res%checksum = sum(abs(model%pts%x(:, 1:np))) + sum(abs(model%pts%v(:, 1:np))) / BENCH_V0 &
                      + sum(abs(model%pts%stress(:, 1:np))) / BENCH_E
@@ -435,7 +443,8 @@ contains
       ',"confinement":'//num(res%confinement)//',"particles":'//str(res%particles)//',"nodes":'//str(res%nodes)// &
       ',"steps":'//str(res%steps)//',"threads":'//str(res%threads)//',"seconds":'// &
       num(res%seconds)//',"particle_steps_per_second":'//num(res%particle_steps_per_second)// &
-      ',"newton_iterations_mean":'//num(res%newton_iterations_mean)//',"bytes_per_particle":'// &
+      ',"newton_iterations_mean":'//num(res%newton_iterations_mean)//',"travel_cells":'// &
+      num(res%travel_cells)//',"bytes_per_particle":'// &
       num(res%bytes_per_particle)//',"phase_seconds":{'
     do k = 1, PHASE_COUNT
       if (k > 1) s = s//','

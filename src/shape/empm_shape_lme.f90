@@ -126,6 +126,11 @@ module empm_shape_lme
   real(wp), parameter :: SUMSQ_LO = 1.0e-280_wp, SUMSQ_HI = 1.0e280_wp
   !> Iteration count returned by `lme_point_2d` when the general path must take over.
   integer, parameter :: LME_FALLBACK = -1
+  !> Intervals of a cell in the warm-start table (`start_tab`).
+  integer, parameter :: LME_START_N = 512
+  !> A particle whose λh changed by more than this in its last step starts from the table
+  !> instead of the extrapolation 2λ_n − λ_(n−1) (which is then no longer the closer start).
+  real(wp), parameter :: LME_START_MOVE = 1.0e-3_wp
 
   !> Local max-ent shape functions with uniform or node-wise γ.
   !>
@@ -140,6 +145,12 @@ module empm_shape_lme
     !> `set_gamma_nodes` or `set_gamma_box`, which also keep `gamma_min` up to date.
     real(wp), allocatable :: gamma_node(:)
     real(wp) :: gamma_min = 0.0_wp             !! min of gamma_node (set with gamma_node)
+    !> Warm starts of moving particles (uniform γ; built by `configure`, absent otherwise):
+    !> column k holds λ_k h of the one-dimensional problem of direction k, whose product over
+    !> the directions solves the problem on the whole box of candidates, at LME_START_N + 1
+    !> evenly spaced points of a cell (docs/shape-functions.md, "Warm starts").
+    real(wp), allocatable :: start_tab(:,:)
+    real(wp) :: start_h(3) = 0.0_wp            !! grid spacings the table was built for
   contains
     procedure :: max_nodes => lme_max_nodes
     procedure :: eval_point => lme_eval_point
@@ -309,6 +320,12 @@ module empm_shape_lme
       integer, intent(out) :: info                 !! SHAPE_OK or the failing particle's code
       integer, intent(out) :: iters                !! Newton iterations summed over the particles
     end subroutine lme_eval_batch_iters
+
+    !> Build `start_tab` for `grid` (uniform γ and valid parameters; otherwise none).
+    module subroutine lme_build_start(self, grid)
+      class(empm_shape_lme_t), intent(inout) :: self !! shape family
+      type(empm_grid_t), intent(in) :: grid          !! background grid
+    end subroutine lme_build_start
 
     ! ---- empm_shape_lme_newton: the general path and the parameter helpers it inlines ---------
 

@@ -51,7 +51,7 @@ contains
     integer, intent(out) :: iters                !! total Newton iterations
     integer :: p, it, pinfo, nd, k
     real(wp) :: lam(3), hs, cut, rmax
-    logical :: fast
+    logical :: fast, table
     iters = 0
     call shape_batch_fits(pts%np, basis, ibad, info)
     if (info /= SHAPE_OK) return
@@ -62,10 +62,14 @@ contains
     hs = lme_h(grid)
     cut = -log(self%tol0)
     rmax = sqrt(cut / self%gamma) * hs
+    ! The warm-start table applies to the grid it was built for.
+    table = allocated(self%start_tab) .and. .not. allocated(self%gamma_node)
+    if (table) table = size(self%start_tab, 2) == nd
+    if (table) table = all(self%start_h(1:nd) == grid%h(1:nd))
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
     !$omp parallel do default(none) schedule(static) &
-    !$omp   shared(self, grid, pts, basis, fast, nd, hs, cut, rmax, ibad, info) &
+    !$omp   shared(self, grid, pts, basis, fast, table, nd, hs, cut, rmax, ibad, info) &
     !$omp   private(pinfo, it, lam, k) reduction(+: iters) if(pts%np >= EMPM_OMP_MIN_PARTICLES)
     do p = 1, pts%np
       ! What this evaluation starts from, kept so that it can be repeated exactly.
@@ -74,10 +78,17 @@ contains
       ! λ* changes smoothly, so 2λ_n − λ_(n−1) is off by O(Δx²) and one Newton step usually
       ! reaches the tolerance (the plain warm start λ_n needs two). lam_old = huge marks a
       ! particle without a converged history yet (set at generation): plain warm start.
+      ! A particle that moved (its λ changed by more than LME_START_MOVE/h in its last step)
+      ! starts from the table when there is one (`start_tab`): the extrapolation is off by
+      ! O(Δλ²), the table by about tol0 wherever the particle is.
       if (pts%lam_old(1, p) == huge(1.0_wp)) then
         lam(1:nd) = pts%lam(:, p)
       else
         lam(1:nd) = 2.0_wp * pts%lam(:, p) - pts%lam_old(:, p)
+        if (table) then
+          if (maxval(abs(pts%lam(:, p) - pts%lam_old(:, p))) * hs > LME_START_MOVE) &
+            call table_start(pts%x(:, p), lam)
+        end if
       end if
       it = LME_FALLBACK
       if (fast) call lme_point_2d(grid, pts%x(:, p), self%gamma, cut, hs, rmax, &
@@ -126,6 +137,26 @@ contains
 
   contains
 
+    !> λ at x from `start_tab` (linear interpolation in each direction), when the box of
+    !> candidates lies inside the grid in every direction; `lam` is left as it is otherwise
+    !> (near a face λ* grows without bound and the one-dimensional problem is another one).
+    pure subroutine table_start(x, lam)
+      real(wp), intent(in) :: x(:)         !! point (nd)
+      real(wp), intent(inout) :: lam(3)    !! start [1/length]
+      real(wp) :: s, t, w, rd, l(3)
+      integer :: k, j
+      do k = 1, nd
+        s = (x(k) - grid%origin(k)) * grid%inv_h(k)
+        rd = rmax * grid%inv_h(k)
+        if (.not. (s - rd >= 0.0_wp .and. s + rd <= grid%ncell(k))) return
+        t = (s - aint(s)) * LME_START_N
+        j = min(int(t), LME_START_N - 1)
+        w = t - j
+        l(k) = (1.0_wp - w) * self%start_tab(j, k) + w * self%start_tab(j + 1, k)
+      end do
+      lam(1:nd) = l(1:nd) / hs
+    end subroutine table_start
+
     !> The common case, lean: 2D, uniform γ, a warm start near λ*. The same basis as
     !> [[lme_point]] (to the Newton tolerance), with the work fused into three passes over the
     !> support: one finds the candidates (all active, since the box is filtered by
@@ -157,7 +188,11 @@ contains
       real(wp) :: s1, s2, rd1, rd2, xi1, xi2, q, f, fmax, qmax, x2max, xlo1, xhi1, xlo2, xhi2
       real(wp) :: l1, l2, c1, c2, sw, m1(2), m2(3), m3(4), logz, r(2), jm(3), ji(3), scl, rn
       real(wp) :: d1, d2, dn2, b1, b2, mm(4), det, q1, q2, t1(2), t2(3), st, rt1, rt2, p, v1, v2
-      real(wp) :: slope, logz0
+      real(wp) :: slope, logz0, xi22
+      ! Widest box of candidate columns kept (a wider one, γ below about 0.06 with tol0 = 1e-6,
+      ! falls back to the general path).
+      integer, parameter :: BOX_MAX = 32
+      real(wp) :: xr(BOX_MAX), xr2(BOX_MAX)
       integer :: lo1, hi1, lo2, hi2, i, j, id0, a, amax, it
       logical :: guard, far
       nn = 0
@@ -175,12 +210,20 @@ contains
       lo2 = max(0, ceiling(s2 - rd2)); hi2 = min(grid%ncell(2), floor(s2 + rd2))
       fmax = -huge(1.0_wp); amax = 0; qmax = 0.0_wp
       xlo1 = huge(1.0_wp); xhi1 = -huge(1.0_wp); xlo2 = huge(1.0_wp); xhi2 = -huge(1.0_wp)
+      ! ξ₁ and ξ₁² of the box's columns once, not in every row: the same values (the same
+      ! expressions), without a division per node.
+      if (hi1 - lo1 >= BOX_MAX) return
+      do i = lo1, hi1
+        xr(i - lo1 + 1) = (x(1) - (grid%origin(1) + i * grid%h(1))) / h
+        xr2(i - lo1 + 1) = xr(i - lo1 + 1)**2
+      end do
       do j = lo2, hi2
         xi2 = (x(2) - (grid%origin(2) + j * grid%h(2))) / h
+        xi22 = xi2**2
         id0 = grid%id0 + grid%ln(1) * j
         do i = lo1, hi1
-          xi1 = (x(1) - (grid%origin(1) + i * grid%h(1))) / h
-          q = gamma * (xi1**2 + xi2**2)
+          xi1 = xr(i - lo1 + 1)
+          q = gamma * (xr2(i - lo1 + 1) + xi22)
           if (q > cut) cycle
           if (nn == cap) return
           nn = nn + 1
