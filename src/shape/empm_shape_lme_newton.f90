@@ -42,9 +42,9 @@ contains
   end procedure gamma_lowest
 
   module procedure lme_point
-    real(wp) :: hs, cut, rmax, s, rd, xi(3), q, ga
+    real(wp) :: hs, cut, rmax, s, rd, xi(3), q, ga, xr(256)
     integer :: nd, d, lo(3), hi(3), i, j, k, id, id0, cap
-    logical :: varying
+    logical :: varying, hoist
     nn = 0
     iters = 0
     nd = grid%ndim
@@ -74,6 +74,14 @@ contains
     ! row. ξ and q are the same expressions as before, so the candidate set is unchanged.
     xi = 0.0_wp
     ga = scale * self%gamma
+    ! ξ₁ of the box's columns once (the same expression): no division per candidate (in the
+    ! loop for a box wider than xr: γ below about 1e-3).
+    hoist = hi(1) - lo(1) < size(xr)
+    if (hoist) then
+      do i = lo(1), hi(1)
+        xr(i - lo(1) + 1) = (x(1) - (grid%origin(1) + i * grid%h(1))) / hs
+      end do
+    end if
     do k = lo(3), hi(3)
       if (nd >= 3) xi(3) = (x(3) - (grid%origin(3) + k * grid%h(3))) / hs
       do j = lo(2), hi(2)
@@ -81,7 +89,11 @@ contains
         id0 = grid%id0 + grid%ln(1) * (j + grid%ln(2) * k)
         do i = lo(1), hi(1)
           id = id0 + i
-          xi(1) = (x(1) - (grid%origin(1) + i * grid%h(1))) / hs
+          if (hoist) then
+            xi(1) = xr(i - lo(1) + 1)
+          else
+            xi(1) = (x(1) - (grid%origin(1) + i * grid%h(1))) / hs
+          end if
           if (varying) ga = scale * self%gamma_node(id)
           q = ga * (xi(1)**2 + xi(2)**2 + xi(3)**2)
           if (q > cut) cycle
@@ -314,6 +326,31 @@ contains
           jt(1, 2) = jt(1, 2) + (p * v(2)) * v(1)
           jt(2, 2) = jt(2, 2) + (p * v(2)) * v(2)
         end do
+      else if (nd == 3 .and. .not. varying) then
+        ! 3D with scalars: the general loop's expressions (dot_product adds from zero).
+        do a = 1, nc
+          if (N(a) < 0.0_wp) then
+            N(a) = 0.0_wp
+            cycle
+          end if
+          v(1) = dN(1, a) - r(1)
+          v(2) = dN(2, a) - r(2)
+          v(3) = dN(3, a) - r(3)
+          p = N(a) * (1.0_wp + (((0.0_wp + v(1) * del(1)) + v(2) * del(2)) + v(3) * del(3)))
+          N(a) = p
+          s = s + p
+          v(1) = dN(1, a) - cen(1)
+          v(2) = dN(2, a) - cen(2)
+          v(3) = dN(3, a) - cen(3)
+          rt(1) = rt(1) + p * v(1)
+          rt(2) = rt(2) + p * v(2)
+          rt(3) = rt(3) + p * v(3)
+          do i = 1, 3
+            jt(1, i) = jt(1, i) + (p * v(i)) * v(1)
+            jt(2, i) = jt(2, i) + (p * v(i)) * v(2)
+            jt(3, i) = jt(3, i) + (p * v(i)) * v(3)
+          end do
+        end do
       else
         do a = 1, nc
           if (N(a) < 0.0_wp) then
@@ -367,6 +404,22 @@ contains
           y(2) = jinv(2, 1) * v(1) + jinv(2, 2) * v(2)
           dN(1, a) = -N(a) * y(1) / h
           dN(2, a) = -N(a) * y(2) / h
+        end do
+      else if (nd == 3 .and. .not. varying) then
+        ! 3D with scalars, as the general loop below.
+        do a = 1, nc
+          if (N(a) == 0.0_wp) then
+            dN(1:3, a) = 0.0_wp
+            cycle
+          end if
+          N(a) = N(a) / s
+          v(1) = dN(1, a) - r(1)
+          v(2) = dN(2, a) - r(2)
+          v(3) = dN(3, a) - r(3)
+          y = matvec(3, jinv, v)
+          dN(1, a) = -N(a) * y(1) / h
+          dN(2, a) = -N(a) * y(2) / h
+          dN(3, a) = -N(a) * y(3) / h
         end do
       else
         do a = 1, nc
@@ -472,6 +525,37 @@ contains
         sj(2, 2) = sj(2, 2) + (e * u(2)) * u(2)
       end do
       sj(1, 2) = sj(2, 1)
+    else if (nd == 3 .and. .not. varying .and. nc <= MOM_BUF) then
+      ! 3D the same way: the general loop's expressions written out (sum and dot_product of
+      ! three terms add from the first; all nine sj(i, j) as there), the exponents kept.
+      do a = 1, nc
+        if (w(a) < 0.0_wp) cycle
+        f = -(gamma * ((xi(1, a)**2 + xi(2, a)**2) + xi(3, a)**2)) + &
+            ((lh(1) * xi(1, a) + lh(2) * xi(2, a)) + lh(3) * xi(3, a))
+        fa(a) = f
+        if (f > fmax) then
+          fmax = f
+          amax = a
+        end if
+      end do
+      if (amax > 0) c(1:3) = xi(1:3, amax)
+      do a = 1, nc
+        if (w(a) < 0.0_wp) cycle
+        e = exp(fa(a) - fmax)
+        w(a) = e
+        s = s + e
+        u(1) = xi(1, a) - c(1)
+        u(2) = xi(2, a) - c(2)
+        u(3) = xi(3, a) - c(3)
+        sr(1) = sr(1) + e * u(1)
+        sr(2) = sr(2) + e * u(2)
+        sr(3) = sr(3) + e * u(3)
+        do i = 1, 3
+          sj(1, i) = sj(1, i) + (e * u(i)) * u(1)
+          sj(2, i) = sj(2, i) + (e * u(i)) * u(2)
+          sj(3, i) = sj(3, i) + (e * u(i)) * u(3)
+        end do
+      end do
     else
       do a = 1, nc
         if (w(a) < 0.0_wp) cycle
@@ -627,6 +711,13 @@ contains
       y(1) = a(1, 1) * v(1) + a(1, 2) * v(2)
       y(2) = a(2, 1) * v(1) + a(2, 2) * v(2)
       y(3) = 0.0_wp
+      return
+    end if
+    if (nd == 3) then
+      ! The loops' sums in the same order, from the same zero.
+      do i = 1, 3
+        y(i) = ((0.0_wp + a(i, 1) * v(1)) + a(i, 2) * v(2)) + a(i, 3) * v(3)
+      end do
       return
     end if
     y = 0.0_wp
