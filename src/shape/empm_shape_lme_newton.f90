@@ -42,8 +42,8 @@ contains
   end procedure gamma_lowest
 
   module procedure lme_point
-    real(wp) :: hs, cut, rmax, s, rd, xi(3), q, ga, xr(256)
-    integer :: nd, d, lo(3), hi(3), i, j, k, id, id0, cap
+    real(wp) :: hs, cut, rmax, s, rd, xi(3), q, ga, xr(256), s1, rem, w
+    integer :: nd, d, lo(3), hi(3), i, j, k, id, id0, cap, i0, i1
     logical :: varying, hoist
     nn = 0
     iters = 0
@@ -82,12 +82,23 @@ contains
         xr(i - lo(1) + 1) = (x(1) - (grid%origin(1) + i * grid%h(1))) / hs
       end do
     end if
+    s1 = (x(1) - grid%origin(1)) * grid%inv_h(1)
     do k = lo(3), hi(3)
       if (nd >= 3) xi(3) = (x(3) - (grid%origin(3) + k * grid%h(3))) / hs
       do j = lo(2), hi(2)
         if (nd >= 2) xi(2) = (x(2) - (grid%origin(2) + j * grid%h(2))) / hs
         id0 = grid%id0 + grid%ln(1) * (j + grid%ln(2) * k)
-        do i = lo(1), hi(1)
+        i0 = lo(1); i1 = hi(1)
+        if (.not. varying) then
+          ! Only the row's columns that can pass the test below, |ξ₁|² ≤ cut/γ − ξ₂² − ξ₃²
+          ! (a disk or ball, not the whole box), widened by 1e-6 cell against rounding: the
+          ! test still decides, so the candidates and their order are the same.
+          rem = cut / ga - (xi(2)**2 + xi(3)**2)
+          if (rem < -1.0e-9_wp * (cut / ga)) cycle
+          w = sqrt(max(rem, 0.0_wp)) * hs * grid%inv_h(1) + 1.0e-6_wp
+          i0 = max(lo(1), ceiling(s1 - w)); i1 = min(hi(1), floor(s1 + w))
+        end if
+        do i = i0, i1
           id = id0 + i
           if (hoist) then
             xi(1) = xr(i - lo(1) + 1)
