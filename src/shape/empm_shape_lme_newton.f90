@@ -360,18 +360,7 @@ contains
           v(3) = dN(3, a) - r(3)
           p = N(a) * (1.0_wp + (((0.0_wp + v(1) * del(1)) + v(2) * del(2)) + v(3) * del(3)))
           N(a) = p
-          s = s + p
-          v(1) = dN(1, a) - cen(1)
-          v(2) = dN(2, a) - cen(2)
-          v(3) = dN(3, a) - cen(3)
-          rt(1) = rt(1) + p * v(1)
-          rt(2) = rt(2) + p * v(2)
-          rt(3) = rt(3) + p * v(3)
-          do i = 1, 3
-            jt(1, i) = jt(1, i) + (p * v(i)) * v(1)
-            jt(2, i) = jt(2, i) + (p * v(i)) * v(2)
-            jt(3, i) = jt(3, i) + (p * v(i)) * v(3)
-          end do
+          call add_moments_3d(p, dN(:, a), cen, s, rt, jt)
         end do
       else
         do a = 1, nc
@@ -565,18 +554,7 @@ contains
         if (w(a) < 0.0_wp) cycle
         e = exp(fa(a) - fmax)
         w(a) = e
-        s = s + e
-        u(1) = xi(1, a) - c(1)
-        u(2) = xi(2, a) - c(2)
-        u(3) = xi(3, a) - c(3)
-        sr(1) = sr(1) + e * u(1)
-        sr(2) = sr(2) + e * u(2)
-        sr(3) = sr(3) + e * u(3)
-        do i = 1, 3
-          sj(1, i) = sj(1, i) + (e * u(i)) * u(1)
-          sj(2, i) = sj(2, i) + (e * u(i)) * u(2)
-          sj(3, i) = sj(3, i) + (e * u(i)) * u(3)
-        end do
+        call add_moments_3d(e, xi(:, a), c, s, sr, sj)
       end do
     else
       do a = 1, nc
@@ -720,6 +698,27 @@ contains
       norm_small = norm2(v(1:nd))
     end if
   end function norm_small
+
+  ! One 3D node's weight e at ξ added to the sums about c: S0 += e, S1 += e u, S2 += (e u_i) u_j
+  ! (all nine, in the general loops' order), u = ξ − c.
+  pure subroutine add_moments_3d(e, xi, c, s0, s1, s2)
+    real(wp), intent(in) :: e, xi(:), c(3)
+    real(wp), intent(inout) :: s0, s1(3), s2(3, 3)
+    real(wp) :: u(3)
+    integer :: i
+    s0 = s0 + e
+    u(1) = xi(1) - c(1)
+    u(2) = xi(2) - c(2)
+    u(3) = xi(3) - c(3)
+    s1(1) = s1(1) + e * u(1)
+    s1(2) = s1(2) + e * u(2)
+    s1(3) = s1(3) + e * u(3)
+    do i = 1, 3
+      s2(1, i) = s2(1, i) + (e * u(i)) * u(1)
+      s2(2, i) = s2(2, i) + (e * u(i)) * u(2)
+      s2(3, i) = s2(3, i) + (e * u(i)) * u(3)
+    end do
+  end subroutine add_moments_3d
 
   !> y = A v for the leading nd×nd block (explicit loops: no temporaries).
   pure function matvec(nd, a, v) result(y)
