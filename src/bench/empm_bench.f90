@@ -91,8 +91,9 @@ module empm_bench
     real(wp) :: seconds = 0.0_wp                        !! wall time of the timed steps [s]
     real(wp) :: particle_steps_per_second = 0.0_wp      !! particles × steps / seconds
     real(wp) :: newton_iterations_mean = 0.0_wp         !! per particle-step (LME; else 0)
-    real(wp) :: travel_cells = 0.0_wp                   !! mean distance a particle moved over
-                                                        !! the timed steps, in cells (sampled)
+    real(wp) :: travel_cells = 0.0_wp                   !! mean net displacement of a particle
+                                                        !! over the timed steps, in cells
+                                                        !! (sampled)
     real(wp) :: bytes_per_particle = 0.0_wp             !! (peak RSS − baseline) / particles
     real(wp) :: phase_seconds(PHASE_COUNT) = 0.0_wp     !! shape, p2g, grid, g2p, stress [s]
     real(wp) :: checksum = 0.0_wp                       !! Σ|x| + Σ|v|/v0 + Σ|σ|/E at the end
@@ -254,8 +255,8 @@ contains
     call integ%timer%reset()
     ticks = 0; nchanged = 0
     if (model%pts%nstate > 0) allocate(state0(model%pts%nstate, model%pts%np))
-    ! The distance travelled, on at most ~1024 particles (a copy of every position would add to
-    ! the peak memory that `bytes_per_particle` reports).
+    ! The net displacement, on every (np/1024)-th particle (1024 to 2047 of them; all below
+    ! 1024): a copy of every position would add to the peak memory `bytes_per_particle` reports.
     stride = max(1, model%pts%np / 1024)
     x0 = model%pts%x(:, 1:model%pts%np:stride)
     do k = 1, cfg%steps

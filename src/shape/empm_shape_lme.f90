@@ -20,16 +20,24 @@
 !> Δ = −J⁻¹ r (closed-form inverse, d ≤ 3, of J scaled to unit norm, with a conditioning
 !> check), the step length capped at `LME_STEP_MAX`, and Armijo backtracking on log Z while
 !> |r| > `LME_TOL_GUARD`, full steps after (backtracking all the way stalls on round-off).
-!> Converged when |r| < `LME_TOL_CONV`, i.e. ‖r_phys‖/h < 1e-10. The moments r and J are
+!> Converged when |r| < `LME_TOL_CONV`, i.e. ‖r_phys‖/h < 1e-10, or (3D with uniform γ, after
+!> no guarded step) when a bound proves the residual after the final linearised step below it,
+!> as in the 2D batch path. The moments r and J are
 !> accumulated about ξ of the heaviest node, so that J has no cancellation when one node carries
 !> nearly all the weight (large γ far from λ*, where J is tiny but well conditioned).
 !>
 !> **Final linearised step.** With Δ = −J⁻¹r at convergence, p̃_a = p_a (1 + (ξ_a − r)·Δ) is p
-!> at λ + Δ to first order (error O(|Δ|²) < 1e-18), costs no exponential, and makes Σp̃ = 1 and
+!> at λ + Δ to first order (error O(|Δ|²): < 1e-18 after ‖r‖ < 1e-10, < 1e-10 after the
+!> bound), costs no exponential, and makes Σp̃ = 1 and
 !> Σ p̃ ξ = 0 (linear reproduction) hold to round-off instead of to the tolerance 1e-10. It is
 !> skipped when some factor 1 + (ξ_a − r)·Δ could fall below 1/2 (points within ~1e-9 h of the
 !> hull boundary), where reproduction then holds to 1e-10 h. The returned p are the p̃, and
 !> r, J below are their moments (r ≈ 1e-16).
+!>
+!> **Warm starts.** `eval_batch` starts a particle from 2λ_n − λ_(n−1), or, when its λ changed
+!> by more than `LME_START_MOVE`/h in its last step, from `start_tab` (the one-dimensional
+!> problems' multipliers, built by `configure`; docs/shape-functions.md, "Warm starts of moving
+!> particles").
 !>
 !> **2D batch path.** `eval_batch` in 2D with uniform γ uses `lme_point_2d`: the same
 !> algorithm in three passes over the support, stopping Newton early when a bound proves the
@@ -151,6 +159,8 @@ module empm_shape_lme
     !> evenly spaced points of a cell (docs/shape-functions.md, "Warm starts").
     real(wp), allocatable :: start_tab(:,:)
     real(wp) :: start_h(3) = 0.0_wp            !! grid spacings the table was built for
+    real(wp) :: start_gamma = 0.0_wp           !! γ the table was built for
+    real(wp) :: start_tol0 = 0.0_wp            !! tol0 the table was built for
   contains
     procedure :: max_nodes => lme_max_nodes
     procedure :: eval_point => lme_eval_point
@@ -321,7 +331,8 @@ module empm_shape_lme
       integer, intent(out) :: iters                !! Newton iterations summed over the particles
     end subroutine lme_eval_batch_iters
 
-    !> Build `start_tab` for `grid` (uniform γ and valid parameters; otherwise none).
+    !> Build `start_tab` for `grid` (uniform γ and valid parameters with 2 to 64 nodes across
+    !> the support in each direction; otherwise none).
     module subroutine lme_build_start(self, grid)
       class(empm_shape_lme_t), intent(inout) :: self !! shape family
       type(empm_grid_t), intent(in) :: grid          !! background grid

@@ -62,9 +62,11 @@ contains
     hs = lme_h(grid)
     cut = -log(self%tol0)
     rmax = sqrt(cut / self%gamma) * hs
-    ! The warm-start table applies to the grid it was built for.
+    ! The warm-start table applies to the grid and parameters it was built for (γ and tol0 may
+    ! be set directly after `configure`).
     table = allocated(self%start_tab) .and. .not. allocated(self%gamma_node)
-    if (table) table = size(self%start_tab, 2) == nd
+    if (table) table = size(self%start_tab, 2) == nd .and. self%start_gamma == self%gamma &
+      .and. self%start_tol0 == self%tol0
     if (table) table = all(self%start_h(1:nd) == grid%h(1:nd))
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
@@ -189,9 +191,10 @@ contains
       real(wp) :: l1, l2, c1, c2, sw, m1(2), m2(3), m3(4), logz, r(2), jm(3), ji(3), scl, rn
       real(wp) :: d1, d2, dn2, b1, b2, mm(4), det, q1, q2, t1(2), t2(3), st, rt1, rt2, p, v1, v2
       real(wp) :: slope, logz0, xi22
-      ! Widest box of candidate columns kept (a wider one, γ below about 0.06 with tol0 = 1e-6,
-      ! falls back to the general path).
-      integer, parameter :: BOX_MAX = 32
+      ! Widest box of candidate columns kept (a wider one, with γ below about 0.015 on square
+      ! cells and tol0 = 1e-6, or cells much narrower in x than h, falls back to the general
+      ! path).
+      integer, parameter :: BOX_MAX = 64
       real(wp) :: xr(BOX_MAX), xr2(BOX_MAX)
       integer :: lo1, hi1, lo2, hi2, i, j, id0, a, amax, it
       logical :: guard, far

@@ -91,11 +91,12 @@ contains
         i0 = lo(1); i1 = hi(1)
         if (.not. varying) then
           ! Only the row's columns that can pass the test below, |ξ₁|² ≤ cut/γ − ξ₂² − ξ₃²
-          ! (a disk or ball, not the whole box), widened by 1e-6 cell against rounding: the
-          ! test still decides, so the candidates and their order are the same.
+          ! (a disk or ball, not the whole box), widened against rounding (in ξ₁², relative
+          ! to cut/γ; and 1e-6 cell): the test still decides, so the candidates and their
+          ! order are the same.
           rem = cut / ga - (xi(2)**2 + xi(3)**2)
           if (rem < -1.0e-9_wp * (cut / ga)) cycle
-          w = sqrt(max(rem, 0.0_wp)) * hs * grid%inv_h(1) + 1.0e-6_wp
+          w = sqrt(max(rem, 0.0_wp) + 1.0e-12_wp * (cut / ga)) * hs * grid%inv_h(1) + 1.0e-6_wp
           i0 = max(lo(1), ceiling(s1 - w)); i1 = min(hi(1), floor(s1 + w))
         end if
         do i = i0, i1
@@ -261,7 +262,7 @@ contains
         if (logz < zlow) then
           info = SHAPE_OUTSIDE_HULL; exit main
         end if
-        if (iters >= maxit) then
+        if (iters >= maxit .and. .not. early) then
           info = SHAPE_NOT_CONVERGED; exit main
         end if
         call sym_inverse(nd, jm, jinv, scl, LME_COND_MAX, ok)
@@ -279,6 +280,9 @@ contains
         ! a far start (a guarded step) only on ‖r‖, as in 2D.
         if (early .and. .not. far) then
           if (0.5_wp * (ximax + rn)**3 * (dnorm / scl)**2 < LME_TOL_CONV) exit
+        end if
+        if (iters >= maxit) then ! (after the bound, as in 2D: an iterate that meets it is done)
+          info = SHAPE_NOT_CONVERGED; exit main
         end if
         if (dnorm > LME_STEP_MAX * scl) then
           del = -del * (LME_STEP_MAX / dnorm)
@@ -311,7 +315,8 @@ contains
         end if
       end do
       ! Final step, linearised: p̃_a = p_a (1 + (ξ_a − r)·Δ) with Δ = −J⁻¹r is p at λ + Δ to
-      ! first order (error O(|Δ|²) < 1e-18), costs no exponential, and makes Σp̃ = 1 and
+      ! first order (error O(|Δ|²): < 1e-18 after ‖r‖ < 1e-10, below the tolerance after the
+      ! 3D bound), costs no exponential, and makes Σp̃ = 1 and
       ! Σp̃ ξ = 0 hold to round-off instead of to the convergence tolerance. It is skipped
       ! (Δ = 0) when a factor 1 + (ξ_a − r)·Δ could fall below 1/2, i.e. for points within
       ! ~1e-9 h of the hull boundary, where consistency then holds to the tolerance 1e-10.

@@ -37,6 +37,8 @@ contains
     integer :: nd, nlo, nhi, info
     remedy = 'none'
     gin = 0.0_wp; lo = 0.0_wp; hi = 0.0_wp
+    ! A failed configure leaves no table of the previous parameters behind.
+    if (allocated(self%start_tab)) deallocate(self%start_tab)
     ! The getters do nothing once `err` is set: the first problem is the one reported.
     call group%get(declaration(P_GAMMA), self%gamma, err)
     call group%get(declaration(P_TOL0), self%tol0, err)
@@ -133,6 +135,7 @@ contains
       end do
       self%start_h(k) = grid%h(k)
     end do
+    self%start_gamma = self%gamma; self%start_tol0 = self%tol0
     ! A start is only a hint, but a wrong one would cost iterations everywhere.
     if (.not. all(abs(self%start_tab) < LME_LAM_MAX)) deallocate(self%start_tab)
   end procedure lme_build_start
