@@ -39,6 +39,7 @@ module empm_material_umat
   use empm_material_linear_elastic, only: empm_lame
   use empm_plasticity, only: strain_increment
   use empm_dynlib, only: empm_dynlib_open, empm_dynlib_symbol
+  use empm_files, only: empm_path_beside
   implicit none
   private
   public :: empm_umat_t, UMAT_MAX_PROPS, UMAT_MAX_SUB
@@ -306,17 +307,14 @@ contains
     character(len=:), allocatable, intent(in) :: case_file
     character(len=*), intent(in) :: file
     character(len=:), allocatable :: path
-    integer :: s
-    path = trim(adjustl(file))
-    if (len(path) == 0) return
-    if (path(1:1) == '/') return
-    s = 0
-    if (allocated(case_file)) s = index(case_file, '/', back=.true.)
-    if (s > 0) then
-      path = case_file(1:s)//path
+    if (allocated(case_file)) then
+      path = empm_path_beside(case_file, file)
+      if (index(case_file, '/') > 0) return
     else
-      path = './'//path
+      path = trim(adjustl(file))
     end if
+    if (len(path) == 0) return
+    if (path(1:1) /= '/') path = './'//path
   end function case_relative
 
   !> State variables: `statev1..statevN`, `umat_sse`, `umat_spd`, `umat_scd`, `umat_cuts`.

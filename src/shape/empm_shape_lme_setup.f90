@@ -1,6 +1,7 @@
 !> LME set-up: declared parameters and `configure`, the family's names, the storage bound
 !> `max_nodes`, the support radius and node-wise γ.
 submodule (empm_shape_lme) empm_shape_lme_setup
+  use empm_shape, only: SHAPE_OK
   use empm_params, only: empm_param, PARAM_REAL, PARAM_STR
   use empm_strings, only: str
   implicit none
@@ -85,8 +86,8 @@ contains
   ! one Newton step from this start reaches the tolerance wherever the particle is, while the
   ! extrapolation from a particle's last two λ needs two or more once it crosses cells.
   module procedure lme_build_start
-    real(wp) :: hs, rd, c, s, l, r, jm, f(64), xi(64), w(64), z, a, b
-    integer :: k, j, i, lo, hi, n, it
+    real(wp) :: hs, rd, c, s, lam(1), xi(1, 64), w(64)
+    integer :: k, j, i, lo, hi, n, it, info
     if (allocated(self%start_tab)) deallocate(self%start_tab)
     self%start_h = 0.0_wp
     if (allocated(self%gamma_node) .or. .not. params_ok(self, grid)) return
@@ -94,50 +95,30 @@ contains
     allocate(self%start_tab(0:LME_START_N, grid%ndim))
     do k = 1, grid%ndim
       ! Direction k: ξ_i = (s − i) h_k/h for the nodes i with |s − i| ≤ R/h_k, s the position
-      ! in cells.
+      ! in cells, solved by the general path's guarded Newton (lme_kernel in 1D), each point
+      ! from the previous one's λ.
       c = grid%h(k) / hs
       rd = sqrt(-log(self%tol0) / self%gamma) * hs * grid%inv_h(k)
-      l = 0.0_wp
+      lam = 0.0_wp
       do j = 0, LME_START_N
         s = real(j, wp) / LME_START_N
         lo = ceiling(s - rd); hi = floor(s + rd); n = hi - lo + 1
-        if (n < 2 .or. n > size(xi)) then
+        if (n > size(w)) then
           deallocate(self%start_tab); return ! no usable start: the extrapolation only
         end if
         do i = lo, hi
-          xi(i - lo + 1) = (s - i) * c
+          xi(1, i - lo + 1) = (s - i) * c
         end do
-        ! r(λ) = Σ p ξ increases with λ (its derivative J = Σ p ξ² − r² > 0) from ξ_min < 0
-        ! to ξ_max > 0: Newton from the previous point's λ, kept inside a bracket [a, b] of the
-        ! root (a step that leaves it bisects), which a full Newton step from afar can overshoot.
-        a = -LME_LAM_MAX; b = LME_LAM_MAX
-        do it = 1, 200
-          f(1:n) = -self%gamma * xi(1:n)**2 + l * xi(1:n)
-          w(1:n) = exp(f(1:n) - maxval(f(1:n)))
-          z = sum(w(1:n))
-          r = sum(w(1:n) * xi(1:n)) / z
-          jm = sum(w(1:n) * xi(1:n)**2) / z - r**2
-          if (abs(r) < 1.0e-15_wp) exit
-          if (r > 0.0_wp) then
-            b = l
-          else
-            a = l
-          end if
-          if (jm > 0.0_wp) then
-            l = l - r / jm
-          else
-            l = b + 1.0_wp ! outside: bisect
-          end if
-          if (.not. (l > a .and. l < b)) l = 0.5_wp * (a + b)
-          if (b - a < 1.0e-15_wp * max(1.0_wp, abs(l))) exit
-        end do
-        self%start_tab(j, k) = l
+        call lme_kernel(1, n, self%gamma, self%tol0, hs, self%max_iter, lam, w(1:n), &
+                        xi(:, 1:n), it, info)
+        if (info /= SHAPE_OK) then
+          deallocate(self%start_tab); return
+        end if
+        self%start_tab(j, k) = lam(1) * hs
       end do
       self%start_h(k) = grid%h(k)
     end do
     self%start_gamma = self%gamma; self%start_tol0 = self%tol0
-    ! A start is only a hint, but a wrong one would cost iterations everywhere.
-    if (.not. all(abs(self%start_tab) < LME_LAM_MAX)) deallocate(self%start_tab)
   end procedure lme_build_start
 
   module procedure lme_name
