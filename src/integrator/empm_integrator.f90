@@ -19,7 +19,7 @@ module empm_integrator
   use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_STRESS, &
                         PHASE_G2P
   use empm_material, only: empm_material_ctx_t
-  use empm_shape, only: BASIS_Q4, basis_q4_weights
+  use empm_shape, only: BASIS_LISTS
   use empm_parallel, only: empm_max_threads, empm_chunks, empm_chunk_bounds, &
                            EMPM_OMP_MIN_PARTICLES
   implicit none
@@ -524,8 +524,8 @@ contains
     type(empm_model_t), intent(inout) :: model        !! simulation state
     real(wp), intent(in) :: t                         !! time [s]
     real(wp), intent(inout), contiguous :: f(:,:)     !! nodal forces (ndim, nnode)
-    real(wp) :: s, xf(3), fp(3), t1, t2, Nq(4), dNq(2, 4)
-    integer :: k, j, p, nd, nn, info, i, id
+    real(wp) :: s, xf(3), fp(3)
+    integer :: k, j, p, nd, nn, info, i
     nd = model%grid%ndim
     do k = 1, size(model%loads%tractions)
       associate (tr => model%loads%tractions(k), b => model%basis)
@@ -543,13 +543,12 @@ contains
             do i = 1, nn
               f(:, tr%node(i)) = f(:, tr%node(i)) + tr%N(i) * fp(1:nd)
             end do
-          else if (b%layout == BASIS_Q4) then
-            id = b%cell(p); t1 = b%t(1, p); t2 = b%t(2, p)
-            call basis_q4_weights(t1, t2, b%inv_h(1), b%inv_h(2), Nq, dNq)
-            f(:, id) = f(:, id) + Nq(1) * fp(1:nd)
-            f(:, id + 1) = f(:, id + 1) + Nq(2) * fp(1:nd)
-            f(:, id + b%stride) = f(:, id + b%stride) + Nq(3) * fp(1:nd)
-            f(:, id + b%stride + 1) = f(:, id + b%stride + 1) + Nq(4) * fp(1:nd)
+          else if (b%layout /= BASIS_LISTS) then
+            ! A compact layout: the particle's nodes and values as the transfers have them.
+            call b%get(p, nn, tr%node, tr%N, tr%dN)
+            do i = 1, nn
+              f(:, tr%node(i)) = f(:, tr%node(i)) + tr%N(i) * fp(1:nd)
+            end do
           else
             do i = 1, b%nn(p)
               f(:, b%node(i, p)) = f(:, b%node(i, p)) + b%N(i, p) * fp(1:nd)

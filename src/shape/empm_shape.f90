@@ -16,7 +16,8 @@ module empm_shape
   use empm_particles, only: empm_particles_t
   implicit none
   private
-  public :: empm_shape_t, empm_basis_t, BASIS_LISTS, BASIS_Q4, basis_q4_weights
+  public :: empm_shape_t, empm_basis_t, BASIS_LISTS, BASIS_Q4, BASIS_B9, basis_q4_weights, &
+            basis_b9_factors
   public :: SHAPE_OK, SHAPE_OUTSIDE_GRID, SHAPE_SUPPORT_CLIPPED, SHAPE_NOT_CONVERGED, &
             SHAPE_OUTSIDE_HULL, SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
             shape_status_text
@@ -33,19 +34,30 @@ module empm_shape
   integer, parameter :: BASIS_LISTS = 0 !! layout: node lists with values and gradients (any family)
   integer, parameter :: BASIS_Q4 = 1    !! layout: bilinear on a 2D grid, the cell and two local
                                         !! coordinates per particle (values recomputed when used)
+  integer, parameter :: BASIS_B9 = 2    !! layout: uniform quadratic B-splines on a 2D grid, the
+                                        !! first node of the 3 × 3 stencil and two local
+                                        !! coordinates per particle (values recomputed when used)
 
-  !> Shape-function values and gradients for every particle, in one of two layouts.
+  !> Shape-function values and gradients for every particle, in one of three layouts.
   !>
   !> `BASIS_LISTS` (any family): per particle the number of supporting nodes, their indices,
-  !> values and gradients, contiguous per particle. `BASIS_Q4` (linear shapes on a 2D grid,
-  !> chosen by the family through [[empm_shape_t(type):layout]]): per particle only the lowest
-  !> node of its cell and the local coordinates (t1, t2) in [0, 1]; the four nodes are
-  !> cell, cell + 1, cell + stride, cell + stride + 1 and the values and gradients are the
-  !> bilinear ones of [[basis_q4_weights]], recomputed by every transfer (20 B per particle
-  !> instead of 116 B, read four times a step). Either way, [[basis_get]] gives one particle's
-  !> nodes, values and gradients, the same bits as the transfers use.
+  !> values and gradients, contiguous per particle. Two compact layouts, chosen by a family
+  !> through [[empm_shape_t(type):layout]], keep per particle only a node `cell` and local
+  !> coordinates `t`, and every transfer recomputes the values and gradients from them (20 B
+  !> per particle, read four times a step, instead of 116 B or 252 B):
+  !> - `BASIS_Q4` (linear shapes on a 2D grid): `cell` the lowest node of the particle's cell,
+  !>   t ∈ [0, 1]²; the four nodes cell, cell + 1, cell + stride, cell + stride + 1 and the
+  !>   bilinear values of [[basis_q4_weights]];
+  !> - `BASIS_B9` (uniform quadratic B-splines on a 2D grid): `cell` the first node of the
+  !>   3 × 3 stencil (i₁ = ⌊s − ½⌋ per direction, s the position in cells), t = s − i₁ ∈
+  !>   [0.5, 1.5)²; the nodes cell + a + stride·b (a, b = 0, 1, 2) and the tensor products of
+  !>   [[basis_b9_factors]]. A stencil node of value exactly zero (t = 0.5: a particle at a
+  !>   cell centre) is kept in the stencil, where its terms add ±0; node lists and
+  !>   [[basis_get]] drop it.
+  !> Either way, [[basis_get]] gives one particle's nodes, values and gradients, the same bits
+  !> as the transfers use.
   type :: empm_basis_t
-    integer :: layout = BASIS_LISTS         !! BASIS_LISTS or BASIS_Q4
+    integer :: layout = BASIS_LISTS         !! BASIS_LISTS, BASIS_Q4 or BASIS_B9
     integer :: ndim = 0                     !! spatial dimension
     integer :: maxn = 0                     !! capacity: nodes per particle
     integer :: np = 0                       !! number of particles
@@ -53,10 +65,10 @@ module empm_shape
     integer, allocatable :: node(:,:)       !! lists: node indices (maxn, np)
     real(wp), allocatable :: N(:,:)         !! lists: values N_Ip (maxn, np)
     real(wp), allocatable :: dN(:,:,:)      !! lists: gradients ∇N_Ip (ndim, maxn, np)
-    integer, allocatable :: cell(:)         !! Q4: lowest node of the particle's cell (np)
-    real(wp), allocatable :: t(:,:)         !! Q4: local coordinates in the cell, in [0, 1] (2, np)
-    integer :: stride = 0                   !! Q4: nodes along x (set by the family's batch)
-    real(wp) :: inv_h(2) = 1.0_wp           !! Q4: 1/h per direction (set by the family's batch)
+    integer, allocatable :: cell(:)         !! Q4, B9: first node of the particle's stencil (np)
+    real(wp), allocatable :: t(:,:)         !! Q4, B9: local coordinates (2, np)
+    integer :: stride = 0                   !! Q4, B9: nodes along x (set by the family's batch)
+    real(wp) :: inv_h(2) = 1.0_wp           !! Q4, B9: 1/h per direction (set by the family's batch)
   contains
     procedure :: alloc => basis_alloc
     procedure :: get => basis_get
@@ -192,7 +204,8 @@ contains
   end function shape_layout
 
   !> Allocate basis storage for `np` particles with up to `maxn` nodes each, in `layout`
-  !> (default BASIS_LISTS; BASIS_Q4 needs ndim = 2 and maxn >= 4, otherwise lists are used).
+  !> (default BASIS_LISTS; BASIS_Q4 needs ndim = 2 and maxn >= 4, BASIS_B9 ndim = 2 and
+  !> maxn >= 9, otherwise lists are used).
   !> An allocation failure is reported in `err` when present (with the memory asked for),
   !> otherwise it stops the program.
   subroutine basis_alloc(self, ndim, maxn, np, layout, err)
@@ -200,7 +213,7 @@ contains
     integer, intent(in) :: ndim                !! spatial dimension
     integer, intent(in) :: maxn                !! nodes per particle (capacity)
     integer, intent(in) :: np                  !! number of particles
-    integer, intent(in), optional :: layout    !! BASIS_LISTS (default) or BASIS_Q4
+    integer, intent(in), optional :: layout    !! BASIS_LISTS (default), BASIS_Q4 or BASIS_B9
     type(empm_error_t), intent(inout), optional :: err !! set on an allocation failure
     integer :: stat
     character(len=256) :: msg
@@ -210,8 +223,9 @@ contains
     self%layout = BASIS_LISTS
     if (present(layout)) then
       if (layout == BASIS_Q4 .and. ndim == 2 .and. maxn >= 4) self%layout = BASIS_Q4
+      if (layout == BASIS_B9 .and. ndim == 2 .and. maxn >= 9) self%layout = BASIS_B9
     end if
-    if (self%layout == BASIS_Q4) then
+    if (self%layout /= BASIS_LISTS) then
       allocate(self%cell(np), self%t(2, np), stat=stat, errmsg=msg)
       if (stat /= 0) then
         call empm_raise_error(empm_alloc_error('shape functions ('//str(np)//' particles)', &
@@ -243,10 +257,26 @@ contains
     integer, intent(out) :: node(:)         !! node indices
     real(wp), intent(out) :: N(:)           !! values
     real(wp), intent(out) :: dN(:,:)        !! gradients (ndim, :)
-    integer :: id
+    integer :: id, a, b, m1, m2
+    real(wp) :: w1(3), g1(3), w2(3), g2(3)
     nn = 0
     if (p < 1 .or. p > self%np) return
-    if (self%layout == BASIS_Q4) then
+    if (self%layout == BASIS_B9) then
+      call basis_b9_factors(self%t(1, p), self%inv_h(1), w1, g1, m1)
+      call basis_b9_factors(self%t(2, p), self%inv_h(2), w2, g2, m2)
+      if (size(node) < m1 * m2 .or. size(N) < m1 * m2 .or. size(dN, 1) < 2 .or. &
+          size(dN, 2) < m1 * m2) return
+      ! The node lists' order and products (x fastest; shape_tp_store).
+      do b = 1, m2
+        do a = 1, m1
+          nn = nn + 1
+          node(nn) = self%cell(p) + (a - 1) + self%stride * (b - 1)
+          N(nn) = w1(a) * w2(b)
+          dN(1, nn) = g1(a) * w2(b)
+          dN(2, nn) = g2(b) * w1(a)
+        end do
+      end do
+    else if (self%layout == BASIS_Q4) then
       if (size(node) < 4 .or. size(N) < 4 .or. size(dN, 1) < 2 .or. size(dN, 2) < 4) return
       id = self%cell(p)
       node(1:4) = [id, id + 1, id + self%stride, id + self%stride + 1]
@@ -279,6 +309,23 @@ contains
   end subroutine basis_q4_weights
 
   include 'empm_q4_weights.inc'
+
+  !> The quadratic B-spline factors of the BASIS_B9 layout along one direction at the local
+  !> coordinate t ∈ [0.5, 1.5) with 1/h = `ih` (those of empm_b9_weights.inc, which the B9
+  !> transfers include too), and the number `m` of nodes the node lists keep: 2 when the third
+  !> node's value is exactly zero, otherwise 3.
+  pure subroutine basis_b9_factors(t, ih, w, g, m)
+    real(wp), intent(in) :: t         !! local coordinate, in [0.5, 1.5)
+    real(wp), intent(in) :: ih        !! 1/h along the direction
+    real(wp), intent(out) :: w(3)     !! values
+    real(wp), intent(out) :: g(3)     !! derivatives with respect to x
+    integer, intent(out) :: m         !! nodes with a value the node lists keep (2 or 3)
+    call b9_factors(t, ih, w, g)
+    ! bspline_1d drops the node where r = |t − 2| reaches the support radius 1.5.
+    m = merge(2, 3, 2.0_wp - t >= 1.5_wp)
+  end subroutine basis_b9_factors
+
+  include 'empm_b9_weights.inc'
 
   !> Human-readable text for a SHAPE_* status code.
   pure function shape_status_text(info) result(s)

@@ -112,7 +112,8 @@ contains
     integer :: p, pinfo, nc, c, p0, p1, b
     logical :: q4
     associate (unused_ => self); end associate
-    call shape_batch_fits(pts%np, basis, ibad, info, q4=grid%ndim == 2)
+    call shape_batch_fits(pts%np, basis, ibad, info, &
+                          compact=merge(BASIS_Q4, BASIS_LISTS, grid%ndim == 2))
     if (info /= SHAPE_OK) return
     q4 = basis%layout == BASIS_Q4
     if (q4 .or. (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4)) then
@@ -401,23 +402,24 @@ contains
 
   !> Check that `basis` has storage for `np` particles before a batch (the per-particle
   !> capacity and dimension are checked by [[shape_tp_assemble]]) in a layout the caller
-  !> fills: node lists always, BASIS_Q4 only with `q4 = .true.`. On failure `ibad` is the first
-  !> particle without storage and `info = SHAPE_TOO_MANY_NODES`, or `ibad = 1` and
-  !> `info = SHAPE_BAD_LAYOUT`.
-  pure subroutine shape_batch_fits(np, basis, ibad, info, q4)
+  !> fills: node lists always, a compact layout (BASIS_Q4, BASIS_B9) only when it is
+  !> `compact`. On failure `ibad` is the first particle without storage and
+  !> `info = SHAPE_TOO_MANY_NODES`, or `ibad = 1` and `info = SHAPE_BAD_LAYOUT`.
+  pure subroutine shape_batch_fits(np, basis, ibad, info, compact)
     integer, intent(in) :: np                  !! number of particles to evaluate
     type(empm_basis_t), intent(in) :: basis    !! basis storage
     integer, intent(out) :: ibad               !! 0, or the first particle that does not fit
     integer, intent(out) :: info               !! SHAPE_OK, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT
-    logical, intent(in), optional :: q4        !! the caller can fill BASIS_Q4 (default: no)
-    logical :: q4_ok
+    integer, intent(in), optional :: compact   !! the compact layout the caller can fill
+                                               !! (default: none)
     ibad = 0
     info = SHAPE_OK
     if (np <= 0) return
-    q4_ok = .false.
-    if (present(q4)) q4_ok = q4
-    if (basis%layout == BASIS_Q4) then
-      if (.not. q4_ok) then
+    if (basis%layout /= BASIS_LISTS) then
+      if (.not. present(compact)) then
+        ibad = 1; info = SHAPE_BAD_LAYOUT; return
+      end if
+      if (basis%layout /= compact) then
         ibad = 1; info = SHAPE_BAD_LAYOUT; return
       end if
       if (.not. allocated(basis%cell)) then
