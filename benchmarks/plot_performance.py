@@ -197,7 +197,9 @@ def main():
     for r in speed:
         md.append(f'| {r["shape"]} | {r["threads"]} | {fmt(r["particle_steps_per_second"])} |')
     md.append("")
-    md += materials_section(Path(sys.argv[1]).with_name("materials.jsonl"), rev)
+    # Like the matrix, the material table may be older than this run (given by the caller).
+    md += materials_section(Path(sys.argv[1]).with_name("materials.jsonl"),
+                            os.environ.get("EMPM_MATERIALS_COMMIT") or rev)
     md += run_path_section(Path(sys.argv[1]).with_name("runpath.jsonl"))
     md += threads_section(Path(sys.argv[1]).with_name("threads.jsonl"))
     md += peers_section(Path(sys.argv[1]).with_name("peers.jsonl"))
