@@ -16,8 +16,8 @@ module empm_shape
   use empm_particles, only: empm_particles_t
   implicit none
   private
-  public :: empm_shape_t, empm_basis_t, BASIS_LISTS, BASIS_Q4, BASIS_B9, basis_q4_weights, &
-            basis_b9_factors
+  public :: empm_shape_t, empm_basis_t, BASIS_LISTS, BASIS_Q4, BASIS_B9, BASIS_B27, &
+            basis_q4_weights, basis_b9_factors
   public :: SHAPE_OK, SHAPE_OUTSIDE_GRID, SHAPE_SUPPORT_CLIPPED, SHAPE_NOT_CONVERGED, &
             SHAPE_OUTSIDE_HULL, SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
             shape_status_text
@@ -34,6 +34,8 @@ module empm_shape
   integer, parameter :: BASIS_LISTS = 0 !! layout: node lists with values and gradients (any family)
   integer, parameter :: BASIS_Q4 = 1    !! layout: bilinear on a 2D grid, the cell and two local
                                         !! coordinates per particle (values recomputed when used)
+  integer, parameter :: BASIS_B27 = 3   !! layout: BASIS_B9 on a 3D grid (3 × 3 × 3 stencil, three
+                                        !! local coordinates per particle)
   integer, parameter :: BASIS_B9 = 2    !! layout: uniform quadratic B-splines on a 2D grid, the
                                         !! first node of the 3 × 3 stencil and two local
                                         !! coordinates per particle (values recomputed when used)
@@ -53,7 +55,9 @@ module empm_shape
   !>   [0.5, 1.5)²; the nodes cell + a + stride·b (a, b = 0, 1, 2) and the tensor products of
   !>   [[basis_b9_factors]]. A stencil node of value exactly zero (t = 0.5: a particle at a
   !>   cell centre) is kept in the stencil, where its terms add ±0; node lists and
-  !>   [[basis_get]] drop it.
+  !>   [[basis_get]] drop it;
+  !> - `BASIS_B27`: the same on a 3D grid, the 3 × 3 × 3 stencil's nodes
+  !>   cell + a + stride·b + stride2·c and three local coordinates.
   !> Either way, [[basis_get]] gives one particle's nodes, values and gradients, the same bits
   !> as the transfers use.
   type :: empm_basis_t
@@ -65,10 +69,11 @@ module empm_shape
     integer, allocatable :: node(:,:)       !! lists: node indices (maxn, np)
     real(wp), allocatable :: N(:,:)         !! lists: values N_Ip (maxn, np)
     real(wp), allocatable :: dN(:,:,:)      !! lists: gradients ∇N_Ip (ndim, maxn, np)
-    integer, allocatable :: cell(:)         !! Q4, B9: first node of the particle's stencil (np)
-    real(wp), allocatable :: t(:,:)         !! Q4, B9: local coordinates (2, np)
-    integer :: stride = 0                   !! Q4, B9: nodes along x (set by the family's batch)
-    real(wp) :: inv_h(2) = 1.0_wp           !! Q4, B9: 1/h per direction (set by the family's batch)
+    integer, allocatable :: cell(:)         !! compact: first node of the particle's stencil (np)
+    real(wp), allocatable :: t(:,:)         !! compact: local coordinates (ndim, np)
+    integer :: stride = 0                   !! compact: nodes along x (set by the family's batch)
+    integer :: stride2 = 0                  !! B27: nodes per x-y plane (set by the family's batch)
+    real(wp) :: inv_h(3) = 1.0_wp           !! compact: 1/h per direction (set by the family's batch)
   contains
     procedure :: alloc => basis_alloc
     procedure :: get => basis_get
@@ -205,7 +210,7 @@ contains
 
   !> Allocate basis storage for `np` particles with up to `maxn` nodes each, in `layout`
   !> (default BASIS_LISTS; BASIS_Q4 needs ndim = 2 and maxn >= 4, BASIS_B9 ndim = 2 and
-  !> maxn >= 9, otherwise lists are used).
+  !> maxn >= 9, BASIS_B27 ndim = 3 and maxn >= 27, otherwise lists are used).
   !> An allocation failure is reported in `err` when present (with the memory asked for),
   !> otherwise it stops the program.
   subroutine basis_alloc(self, ndim, maxn, np, layout, err)
@@ -213,7 +218,8 @@ contains
     integer, intent(in) :: ndim                !! spatial dimension
     integer, intent(in) :: maxn                !! nodes per particle (capacity)
     integer, intent(in) :: np                  !! number of particles
-    integer, intent(in), optional :: layout    !! BASIS_LISTS (default), BASIS_Q4 or BASIS_B9
+    integer, intent(in), optional :: layout    !! BASIS_LISTS (default), BASIS_Q4, BASIS_B9 or
+                                               !! BASIS_B27
     type(empm_error_t), intent(inout), optional :: err !! set on an allocation failure
     integer :: stat
     character(len=256) :: msg
@@ -224,16 +230,17 @@ contains
     if (present(layout)) then
       if (layout == BASIS_Q4 .and. ndim == 2 .and. maxn >= 4) self%layout = BASIS_Q4
       if (layout == BASIS_B9 .and. ndim == 2 .and. maxn >= 9) self%layout = BASIS_B9
+      if (layout == BASIS_B27 .and. ndim == 3 .and. maxn >= 27) self%layout = BASIS_B27
     end if
     if (self%layout /= BASIS_LISTS) then
-      allocate(self%cell(np), self%t(2, np), stat=stat, errmsg=msg)
+      allocate(self%cell(np), self%t(ndim, np), stat=stat, errmsg=msg)
       if (stat /= 0) then
         call empm_raise_error(empm_alloc_error('shape functions ('//str(np)//' particles)', &
-          20_int64 * np, msg), err)
+          (4_int64 + 8_int64 * ndim) * np, msg), err)
         return
       end if
       self%cell = 1; self%t = 0.0_wp
-      self%stride = 0; self%inv_h = 1.0_wp
+      self%stride = 0; self%stride2 = 0; self%inv_h = 1.0_wp
     else
       allocate(self%nn(np), self%node(maxn, np), self%N(maxn, np), self%dN(ndim, maxn, np), &
                stat=stat, errmsg=msg)
@@ -257,11 +264,30 @@ contains
     integer, intent(out) :: node(:)         !! node indices
     real(wp), intent(out) :: N(:)           !! values
     real(wp), intent(out) :: dN(:,:)        !! gradients (ndim, :)
-    integer :: id, a, b, m1, m2
-    real(wp) :: w1(3), g1(3), w2(3), g2(3)
+    integer :: id, a, b, c, m1, m2, m3
+    real(wp) :: w1(3), g1(3), w2(3), g2(3), w3(3), g3(3)
     nn = 0
     if (p < 1 .or. p > self%np) return
-    if (self%layout == BASIS_B9) then
+    if (self%layout == BASIS_B27) then
+      call basis_b9_factors(self%t(1, p), self%inv_h(1), w1, g1, m1)
+      call basis_b9_factors(self%t(2, p), self%inv_h(2), w2, g2, m2)
+      call basis_b9_factors(self%t(3, p), self%inv_h(3), w3, g3, m3)
+      if (size(node) < m1 * m2 * m3 .or. size(N) < m1 * m2 * m3 .or. size(dN, 1) < 3 .or. &
+          size(dN, 2) < m1 * m2 * m3) return
+      ! The node lists' order and products (x fastest; shape_tp_store).
+      do c = 1, m3
+        do b = 1, m2
+          do a = 1, m1
+            nn = nn + 1
+            node(nn) = self%cell(p) + (a - 1) + self%stride * (b - 1) + self%stride2 * (c - 1)
+            N(nn) = w1(a) * (w2(b) * w3(c))
+            dN(1, nn) = g1(a) * (w2(b) * w3(c))
+            dN(2, nn) = g2(b) * (w1(a) * w3(c))
+            dN(3, nn) = g3(c) * (w1(a) * w2(b))
+          end do
+        end do
+      end do
+    else if (self%layout == BASIS_B9) then
       call basis_b9_factors(self%t(1, p), self%inv_h(1), w1, g1, m1)
       call basis_b9_factors(self%t(2, p), self%inv_h(2), w2, g2, m2)
       if (size(node) < m1 * m2 .or. size(N) < m1 * m2 .or. size(dN, 1) < 2 .or. &

@@ -26,9 +26,10 @@
 !> padding. Points within 2p cells of a face are evaluated by the Cox–de Boor recursion,
 !> the others by the uniform formulas.
 !>
-!> **Compact layout.** On a 2D grid the uniform quadratic family fills `BASIS_B9` (per particle
-!> the first node of its 3 × 3 stencil and two local coordinates; [[empm_basis_t]]), whose
-!> transfers recompute the values ([[empm_transfer_b9]]). A particle whose stencil is not
+!> **Compact layout.** The uniform quadratic family fills `BASIS_B9` on a 2D grid and
+!> `BASIS_B27` on a 3D one (per particle the first node of its 3^ndim stencil and ndim local
+!> coordinates; [[empm_basis_t]]), whose transfers recompute the values ([[empm_transfer_b9]],
+!> [[empm_transfer_b27]]). A particle whose stencil is not
 !> inside the grid (it is then within h/2 of a face: the node lists drop a node beyond the face
 !> whose value is zero or, within SHAPE_CLIP_TOL, nearly so, or fail with
 !> SHAPE_SUPPORT_CLIPPED) cannot be held by it: the batch then turns the storage into node
@@ -41,7 +42,7 @@ module empm_shape_bspline
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
-                        BASIS_LISTS, BASIS_B9
+                        BASIS_LISTS, BASIS_B9, BASIS_B27
   use empm_shape_linear, only: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, &
                                shape_batch_fits, shape_keep_first_failure, shape_tp_store
   implicit none
@@ -117,13 +118,16 @@ contains
     n = merge(0, 1, self%clamped)
   end function bspline_padding_cells
 
-  !> Basis layout: BASIS_B9 for the uniform quadratic family on a 2D grid (the first node of
-  !> the 3 × 3 stencil and two local coordinates per particle), node lists otherwise.
+  !> Basis layout: for the uniform quadratic family BASIS_B9 on a 2D grid and BASIS_B27 on a
+  !> 3D one (the first node of the 3^ndim stencil and ndim local coordinates per particle),
+  !> node lists otherwise.
   pure integer function bspline_layout(self, grid)
     class(empm_shape_bspline_t), intent(in) :: self !! shape family
     type(empm_grid_t), intent(in) :: grid           !! background grid
     bspline_layout = BASIS_LISTS
-    if (self%order == 2 .and. .not. self%clamped .and. grid%ndim == 2) bspline_layout = BASIS_B9
+    if (self%order /= 2 .or. self%clamped) return
+    if (grid%ndim == 2) bspline_layout = BASIS_B9
+    if (grid%ndim == 3) bspline_layout = BASIS_B27
   end function bspline_layout
 
   !> Family identifier: "bspline2" or "bspline3" ("bspline?" for an unsupported order).
@@ -166,8 +170,8 @@ contains
     type(empm_error_t) :: err
     call shape_batch_fits(pts%np, basis, ibad, info, compact=self%layout(grid))
     if (info /= SHAPE_OK) return
-    if (basis%layout == BASIS_B9) then
-      if (b9_batch(grid, pts, basis, ibad, info)) return
+    if (basis%layout == BASIS_B9 .or. basis%layout == BASIS_B27) then
+      if (compact_batch(grid, pts, basis, ibad, info)) return
       ! A stencil reaches beyond the grid: node lists from now on (one allocation per run).
       call basis%alloc(grid%ndim, basis%maxn, basis%np, BASIS_LISTS, err)
       if (err%code /= 0) then
@@ -234,47 +238,56 @@ contains
     if (ibad == huge(1)) ibad = 0
   end subroutine uniform_batch
 
-  !> The compact quadratic basis (BASIS_B9) at particles 1..pts%np, located as `bspline_1d`
-  !> locates them (s the position in cells, i₁ = ⌊s − ½⌋, t = s − i₁: exact). False, with
-  !> nothing reported, when some particle inside the grid has a stencil that is not (the
-  !> caller turns to node lists); otherwise true, `ibad` the first particle outside the closed
-  !> grid box (the test of grid%inside, which a NaN fails too) or 0.
-  logical function b9_batch(grid, pts, basis, ibad, info) result(held)
-    type(empm_grid_t), intent(in) :: grid           !! background grid (2D)
+  !> The compact quadratic basis (BASIS_B9 in 2D, BASIS_B27 in 3D) at particles 1..pts%np,
+  !> located as `bspline_1d` locates them (s the position in cells, i₁ = ⌊s − ½⌋, t = s − i₁:
+  !> exact). False, with nothing reported, when some particle inside the grid has a stencil
+  !> that is not (the caller turns to node lists); otherwise true, `ibad` the first particle
+  !> outside the closed grid box (the test of grid%inside, which a NaN fails too) or 0.
+  logical function compact_batch(grid, pts, basis, ibad, info) result(held)
+    type(empm_grid_t), intent(in) :: grid           !! background grid (2D or 3D)
     type(empm_particles_t), intent(in) :: pts       !! particles
-    type(empm_basis_t), intent(inout) :: basis      !! BASIS_B9 storage
+    type(empm_basis_t), intent(inout) :: basis      !! BASIS_B9 or BASIS_B27 storage
     integer, intent(out) :: ibad                    !! first particle outside the grid, or 0
     integer, intent(out) :: info                    !! SHAPE_OK or SHAPE_OUTSIDE_GRID
-    real(wp) :: o1, o2, e1, e2, h1, h2, s1, s2
-    integer :: nc, c, p0, p1, p, i1, j1, n1, id0, c1, c2, iout
-    o1 = grid%origin(1); o2 = grid%origin(2)
-    e1 = grid%origin(1) + grid%ncell(1) * grid%h(1)
-    e2 = grid%origin(2) + grid%ncell(2) * grid%h(2)
-    h1 = grid%inv_h(1); h2 = grid%inv_h(2)
-    n1 = grid%ln(1); id0 = grid%id0; c1 = grid%ncell(1) - 2; c2 = grid%ncell(2) - 2
-    basis%stride = n1; basis%inv_h = grid%inv_h(1:2)
+    real(wp) :: o(3), e(3), ih(3), s, t(3)
+    integer :: nc, c, p0, p1, p, d, nd, i, id, id0, lim(3), str(3), iout
+    logical :: inside, fits
+    nd = grid%ndim
+    o = 0.0_wp; e = 0.0_wp; ih = 1.0_wp; lim = 0; str = 0; t = 0.0_wp
+    do d = 1, nd
+      o(d) = grid%origin(d); e(d) = grid%origin(d) + grid%ncell(d) * grid%h(d)
+      ih(d) = grid%inv_h(d); lim(d) = grid%ncell(d) - 2
+    end do
+    str(1) = 1; str(2) = grid%ln(1); str(3) = grid%ln(1) * grid%ln(2); id0 = grid%id0
+    basis%stride = str(2); basis%stride2 = str(3); basis%inv_h(1:nd) = ih(1:nd)
     nc = empm_chunks(pts%np)
     ibad = huge(1); iout = huge(1)
     !$omp parallel do default(none) num_threads(nc) schedule(static, 1) &
-    !$omp   shared(nc, pts, basis, o1, o2, e1, e2, h1, h2, n1, id0, c1, c2) &
-    !$omp   private(p0, p1, p, s1, s2, i1, j1) reduction(min: ibad, iout) if(nc > 1)
+    !$omp   shared(nc, nd, pts, basis, o, e, ih, lim, str, id0) &
+    !$omp   private(p0, p1, p, d, s, i, id, t, inside, fits) reduction(min: ibad, iout) if(nc > 1)
     do c = 0, nc - 1
       call empm_chunk_bounds(pts%np, nc, c, p0, p1)
       do p = p0, p1
-        if (.not. (pts%x(1, p) >= o1 .and. pts%x(1, p) <= e1 .and. pts%x(2, p) >= o2 .and. &
-                   pts%x(2, p) <= e2)) then
+        inside = .true.
+        do d = 1, nd
+          if (.not. (pts%x(d, p) >= o(d) .and. pts%x(d, p) <= e(d))) inside = .false.
+        end do
+        if (.not. inside) then
           ibad = min(ibad, p); cycle
         end if
-        s1 = (pts%x(1, p) - o1) * h1
-        s2 = (pts%x(2, p) - o2) * h2
-        i1 = floor(s1 - 0.5_wp)
-        j1 = floor(s2 - 0.5_wp)
-        if (i1 < 0 .or. i1 > c1 .or. j1 < 0 .or. j1 > c2) then
+        fits = .true.; id = id0
+        do d = 1, nd
+          s = (pts%x(d, p) - o(d)) * ih(d)
+          i = floor(s - 0.5_wp)
+          if (i < 0 .or. i > lim(d)) fits = .false.
+          id = id + str(d) * i
+          t(d) = s - i
+        end do
+        if (.not. fits) then
           iout = min(iout, p); cycle
         end if
-        basis%cell(p) = id0 + i1 + n1 * j1
-        basis%t(1, p) = s1 - i1
-        basis%t(2, p) = s2 - j1
+        basis%cell(p) = id
+        basis%t(1:nd, p) = t(1:nd)
       end do
     end do
     !$omp end parallel do
@@ -285,7 +298,7 @@ contains
     else
       info = SHAPE_OUTSIDE_GRID
     end if
-  end function b9_batch
+  end function compact_batch
 
   !> B-spline shape functions of degree `order` at one point; only nodes with a nonzero value
   !> are returned, in increasing index order.

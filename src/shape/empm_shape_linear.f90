@@ -119,7 +119,7 @@ contains
     if (q4 .or. (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4)) then
       ! 2D: one bilinear kernel call per chunk of particles.
       if (q4) then
-        basis%stride = grid%ln(1); basis%inv_h = grid%inv_h(1:2)
+        basis%stride = grid%ln(1); basis%inv_h(1:2) = grid%inv_h(1:2)
       end if
       nc = empm_chunks(pts%np)
       ibad = huge(1)

@@ -19,14 +19,15 @@
 !>
 !> Every kernel dispatches on the basis layout and dimension once per particle chunk: the
 !> compact bilinear layout (`BASIS_Q4`) goes to [[empm_transfer_q4]], the compact quadratic
-!> B-spline one (`BASIS_B9`) to [[empm_transfer_b9]]; node lists in 2D to the
+!> B-spline ones to [[empm_transfer_b9]] (`BASIS_B9`, 2D) and [[empm_transfer_b27]]
+!> (`BASIS_B27`, 3D); node lists in 2D to the
 !> specialised loops of [[empm_transfer_2d]] for the kernels of the time step (mass +
 !> momentum, internal force, G2P, velocity gradient); everything else to the generic loops
 !> here. All paths do the same arithmetic in the same order (same bits). Nodal and particle
 !> arrays must be contiguous.
 module empm_transfer
   use empm_kinds, only: wp
-  use empm_shape, only: empm_basis_t, BASIS_Q4, BASIS_B9
+  use empm_shape, only: empm_basis_t, BASIS_Q4, BASIS_B9, BASIS_B27
   use empm_nodes, only: empm_nodes_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_transfer_2d, only: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, &
@@ -36,6 +37,8 @@ module empm_transfer
                               internal_force_q4, velocity_gradient_q4, g2p_q4
   use empm_transfer_b9, only: mass_b9, weighted_b9, mass_momentum_b9, body_force_b9, &
                               internal_force_b9, velocity_gradient_b9, g2p_b9
+  use empm_transfer_b27, only: mass_b27, weighted_b27, mass_momentum_b27, body_force_b27, &
+                               internal_force_b27, velocity_gradient_b27, g2p_b27
   implicit none
   private
   public :: empm_p2g_work_t
@@ -128,6 +131,14 @@ contains
         !$omp   shared(basis, p0, p1) reduction(min: lo) reduction(max: hi)
         do p = p0, p1
           lo = min(lo, basis%cell(p)); hi = max(hi, basis%cell(p) + 2 * basis%stride + 2)
+        end do
+        !$omp end parallel do
+      else if (basis%layout == BASIS_B27) then
+        !$omp parallel do num_threads(self%nt) schedule(static) default(none) &
+        !$omp   shared(basis, p0, p1) reduction(min: lo) reduction(max: hi)
+        do p = p0, p1
+          lo = min(lo, basis%cell(p))
+          hi = max(hi, basis%cell(p) + 2 * basis%stride2 + 2 * basis%stride + 2)
         end do
         !$omp end parallel do
       else
@@ -392,6 +403,9 @@ contains
     if (basis%layout == BASIS_B9) then
       call mass_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, m, mass); return
     end if
+    if (basis%layout == BASIS_B27) then
+      call mass_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, m, mass); return
+    end if
     do p = p0, p1
       do k = 1, basis%nn(p)
         mass(basis%node(k, p)) = mass(basis%node(k, p)) + basis%N(k, p) * m(p)
@@ -416,6 +430,10 @@ contains
     end if
     if (basis%layout == BASIS_B9) then
       call weighted_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, m, u, c, w, q)
+      return
+    end if
+    if (basis%layout == BASIS_B27) then
+      call weighted_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, m, u, c, w, q)
       return
     end if
     d = size(u, 1)
@@ -448,6 +466,8 @@ contains
     else if (basis%layout == BASIS_B9) then
       call mass_momentum_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, m, u, c, w, &
                             mass, q)
+    else if (basis%layout == BASIS_B27) then
+      call mass_momentum_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, m, u, c, w, mass, q)
     else if (basis%ndim == 2) then
       call mass_momentum_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, m, u, c, w, &
                             mass, q)
@@ -476,6 +496,10 @@ contains
     if (basis%layout == BASIS_B9) then
       call internal_force_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, vol, &
                              stress, f)
+      return
+    end if
+    if (basis%layout == BASIS_B27) then
+      call internal_force_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, vol, stress, f)
       return
     end if
     if (d == 2) then
@@ -526,6 +550,10 @@ contains
                          f)
       return
     end if
+    if (basis%layout == BASIS_B27) then
+      call body_force_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, m, g, b, use_b, f)
+      return
+    end if
     d = size(g)
     do p = p0, p1
       fp(1:d) = g
@@ -555,6 +583,10 @@ contains
       end if
       if (basis%layout == BASIS_B9) then
         call g2p_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, q, .false., 0.0_wp, u)
+        cycle
+      end if
+      if (basis%layout == BASIS_B27) then
+        call g2p_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, q, .false., 0.0_wp, u)
         cycle
       end if
       if (basis%ndim == 2) then
@@ -595,6 +627,10 @@ contains
     end if
     if (basis%layout == BASIS_B9) then
       call g2p_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, q, .true., c, u)
+      return
+    end if
+    if (basis%layout == BASIS_B27) then
+      call g2p_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, q, .true., c, u)
       return
     end if
     if (d == 2) then
@@ -652,6 +688,10 @@ contains
     end if
     if (basis%layout == BASIS_B9) then
       call velocity_gradient_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, v, L)
+      return
+    end if
+    if (basis%layout == BASIS_B27) then
+      call velocity_gradient_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, v, L)
       return
     end if
     if (d == 2) then
