@@ -16,8 +16,8 @@ module empm_shape
   use empm_particles, only: empm_particles_t
   implicit none
   private
-  public :: empm_shape_t, empm_basis_t, BASIS_LISTS, BASIS_Q4, BASIS_B9, BASIS_B27, &
-            basis_q4_weights, basis_b9_factors
+  public :: empm_shape_t, empm_basis_t, BASIS_LISTS, BASIS_Q4, BASIS_B9, BASIS_B27, BASIS_G9, &
+            BASIS_G27, basis_q4_weights, basis_stencil_factors
   public :: SHAPE_OK, SHAPE_OUTSIDE_GRID, SHAPE_SUPPORT_CLIPPED, SHAPE_NOT_CONVERGED, &
             SHAPE_OUTSIDE_HULL, SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
             shape_status_text
@@ -36,6 +36,9 @@ module empm_shape
                                         !! coordinates per particle (values recomputed when used)
   integer, parameter :: BASIS_B27 = 3   !! layout: BASIS_B9 on a 3D grid (3 × 3 × 3 stencil, three
                                         !! local coordinates per particle)
+  integer, parameter :: BASIS_G9 = 4    !! layout: uGIMP on a 2D grid, the first node of the 3 × 3
+                                        !! stencil, two local coordinates and two half-lengths
+  integer, parameter :: BASIS_G27 = 5   !! layout: BASIS_G9 on a 3D grid
   integer, parameter :: BASIS_B9 = 2    !! layout: uniform quadratic B-splines on a 2D grid, the
                                         !! first node of the 3 × 3 stencil and two local
                                         !! coordinates per particle (values recomputed when used)
@@ -53,11 +56,17 @@ module empm_shape
   !> - `BASIS_B9` (uniform quadratic B-splines on a 2D grid): `cell` the first node of the
   !>   3 × 3 stencil (i₁ = ⌊s − ½⌋ per direction, s the position in cells), t = s − i₁ ∈
   !>   [0.5, 1.5)²; the nodes cell + a + stride·b (a, b = 0, 1, 2) and the tensor products of
-  !>   [[basis_b9_factors]]. A stencil node of value exactly zero (t = 0.5: a particle at a
+  !>   [[basis_stencil_factors]]. A stencil node of value exactly zero (t = 0.5: a particle at a
   !>   cell centre) is kept in the stencil, where its terms add ±0; node lists and
   !>   [[basis_get]] drop it;
   !> - `BASIS_B27`: the same on a 3D grid, the 3 × 3 × 3 stencil's nodes
-  !>   cell + a + stride·b + stride2·c and three local coordinates.
+  !>   cell + a + stride·b + stride2·c and three local coordinates;
+  !> - `BASIS_G9`, `BASIS_G27` (uGIMP on a 2D, 3D grid): `cell` the node below the nearest one
+  !>   per direction (c − 1, c = nint(s)) and `wg` the 1D factors of `g9_factors`
+  !>   (empm_stencil_weights.inc), stored rather than recomputed (their pieces branch and
+  !>   divide: recomputed nine times a step they cost more than they save); a node beyond the
+  !>   support has value and slope 0, and the node lists and [[basis_get]] drop it (a kept
+  !>   node's value is positive). 100 B per particle in 2D, 148 B in 3D.
   !> Either way, [[basis_get]] gives one particle's nodes, values and gradients, the same bits
   !> as the transfers use.
   type :: empm_basis_t
@@ -72,7 +81,11 @@ module empm_shape
     integer, allocatable :: cell(:)         !! compact: first node of the particle's stencil (np)
     real(wp), allocatable :: t(:,:)         !! compact: local coordinates (ndim, np)
     integer :: stride = 0                   !! compact: nodes along x (set by the family's batch)
-    integer :: stride2 = 0                  !! B27: nodes per x-y plane (set by the family's batch)
+    integer :: stride2 = 0                  !! 3D stencils: nodes per x-y plane (set by the batch)
+    real(wp), allocatable :: wg(:,:,:,:)    !! uGIMP stencils: the 1D values (wg(:, 1, d, p)) and
+                                            !! slopes (wg(:, 2, d, p)) of the 3 stencil nodes per
+                                            !! direction (3, 2, ndim, np); (3, 2, ndim, 1), unused,
+                                            !! for the B-spline ones
     real(wp) :: inv_h(3) = 1.0_wp           !! compact: 1/h per direction (set by the family's batch)
   contains
     procedure :: alloc => basis_alloc
@@ -209,8 +222,8 @@ contains
   end function shape_layout
 
   !> Allocate basis storage for `np` particles with up to `maxn` nodes each, in `layout`
-  !> (default BASIS_LISTS; BASIS_Q4 needs ndim = 2 and maxn >= 4, BASIS_B9 ndim = 2 and
-  !> maxn >= 9, BASIS_B27 ndim = 3 and maxn >= 27, otherwise lists are used).
+  !> (default BASIS_LISTS; BASIS_Q4 needs ndim = 2 and maxn >= 4, BASIS_B9 and BASIS_G9 ndim = 2
+  !> and maxn >= 9, BASIS_B27 and BASIS_G27 ndim = 3 and maxn >= 27, otherwise lists are used).
   !> An allocation failure is reported in `err` when present (with the memory asked for),
   !> otherwise it stops the program.
   subroutine basis_alloc(self, ndim, maxn, np, layout, err)
@@ -218,28 +231,33 @@ contains
     integer, intent(in) :: ndim                !! spatial dimension
     integer, intent(in) :: maxn                !! nodes per particle (capacity)
     integer, intent(in) :: np                  !! number of particles
-    integer, intent(in), optional :: layout    !! BASIS_LISTS (default), BASIS_Q4, BASIS_B9 or
-                                               !! BASIS_B27
+    integer, intent(in), optional :: layout    !! BASIS_LISTS (default) or a compact layout
     type(empm_error_t), intent(inout), optional :: err !! set on an allocation failure
     integer :: stat
     character(len=256) :: msg
+    logical :: gimp
     if (allocated(self%nn)) deallocate(self%nn, self%node, self%N, self%dN)
     if (allocated(self%cell)) deallocate(self%cell, self%t)
+    if (allocated(self%wg)) deallocate(self%wg)
     self%ndim = ndim; self%maxn = maxn; self%np = np
     self%layout = BASIS_LISTS
     if (present(layout)) then
       if (layout == BASIS_Q4 .and. ndim == 2 .and. maxn >= 4) self%layout = BASIS_Q4
       if (layout == BASIS_B9 .and. ndim == 2 .and. maxn >= 9) self%layout = BASIS_B9
       if (layout == BASIS_B27 .and. ndim == 3 .and. maxn >= 27) self%layout = BASIS_B27
+      if (layout == BASIS_G9 .and. ndim == 2 .and. maxn >= 9) self%layout = BASIS_G9
+      if (layout == BASIS_G27 .and. ndim == 3 .and. maxn >= 27) self%layout = BASIS_G27
     end if
     if (self%layout /= BASIS_LISTS) then
-      allocate(self%cell(np), self%t(ndim, np), stat=stat, errmsg=msg)
+      gimp = self%layout == BASIS_G9 .or. self%layout == BASIS_G27
+      allocate(self%cell(np), self%t(ndim, merge(1, np, gimp)), &
+               self%wg(3, 2, ndim, merge(np, 1, gimp)), stat=stat, errmsg=msg)
       if (stat /= 0) then
         call empm_raise_error(empm_alloc_error('shape functions ('//str(np)//' particles)', &
-          (4_int64 + 8_int64 * ndim) * np, msg), err)
+          (4_int64 + 8_int64 * ndim * merge(6, 1, gimp)) * np, msg), err)
         return
       end if
-      self%cell = 1; self%t = 0.0_wp
+      self%cell = 1; self%t = 0.0_wp; self%wg = 0.0_wp
       self%stride = 0; self%stride2 = 0; self%inv_h = 1.0_wp
     else
       allocate(self%nn(np), self%node(maxn, np), self%N(maxn, np), self%dN(ndim, maxn, np), &
@@ -264,42 +282,37 @@ contains
     integer, intent(out) :: node(:)         !! node indices
     real(wp), intent(out) :: N(:)           !! values
     real(wp), intent(out) :: dN(:,:)        !! gradients (ndim, :)
-    integer :: id, a, b, c, m1, m2, m3
-    real(wp) :: w1(3), g1(3), w2(3), g2(3), w3(3), g3(3)
+    integer :: id, a, b, c, d, nd, m, k0(3), k1(3)
+    real(wp) :: w(3, 3), g(3, 3)
     nn = 0
     if (p < 1 .or. p > self%np) return
-    if (self%layout == BASIS_B27) then
-      call basis_b9_factors(self%t(1, p), self%inv_h(1), w1, g1, m1)
-      call basis_b9_factors(self%t(2, p), self%inv_h(2), w2, g2, m2)
-      call basis_b9_factors(self%t(3, p), self%inv_h(3), w3, g3, m3)
-      if (size(node) < m1 * m2 * m3 .or. size(N) < m1 * m2 * m3 .or. size(dN, 1) < 3 .or. &
-          size(dN, 2) < m1 * m2 * m3) return
-      ! The node lists' order and products (x fastest; shape_tp_store).
-      do c = 1, m3
-        do b = 1, m2
-          do a = 1, m1
+    if (self%layout == BASIS_B9 .or. self%layout == BASIS_B27 .or. self%layout == BASIS_G9 &
+        .or. self%layout == BASIS_G27) then
+      ! The factors per direction, and the stencil nodes the node lists keep (k0..k1).
+      nd = self%ndim
+      w = 1.0_wp; g = 0.0_wp; k0 = 1; k1 = 1
+      do d = 1, nd
+        if (self%layout == BASIS_G9 .or. self%layout == BASIS_G27) then
+          w(:, d) = self%wg(:, 1, d, p); g(:, d) = self%wg(:, 2, d, p)
+          k0(d) = merge(2, 1, w(1, d) == 0.0_wp); k1(d) = merge(2, 3, w(3, d) == 0.0_wp)
+        else
+          call basis_stencil_factors(self%layout, self%t(d, p), 0.0_wp, self%inv_h(d), &
+                                     w(:, d), g(:, d), k0(d), k1(d))
+        end if
+      end do
+      m = product(k1 - k0 + 1)
+      if (size(node) < m .or. size(N) < m .or. size(dN, 1) < nd .or. size(dN, 2) < m) return
+      ! The node lists' order and products (x fastest; shape_tp_store; beyond ndim w = 1, exact).
+      do c = k0(3), k1(3)
+        do b = k0(2), k1(2)
+          do a = k0(1), k1(1)
             nn = nn + 1
             node(nn) = self%cell(p) + (a - 1) + self%stride * (b - 1) + self%stride2 * (c - 1)
-            N(nn) = w1(a) * (w2(b) * w3(c))
-            dN(1, nn) = g1(a) * (w2(b) * w3(c))
-            dN(2, nn) = g2(b) * (w1(a) * w3(c))
-            dN(3, nn) = g3(c) * (w1(a) * w2(b))
+            N(nn) = w(a, 1) * (w(b, 2) * w(c, 3))
+            dN(1, nn) = g(a, 1) * (w(b, 2) * w(c, 3))
+            dN(2, nn) = g(b, 2) * (w(a, 1) * w(c, 3))
+            if (nd == 3) dN(3, nn) = g(c, 3) * (w(a, 1) * w(b, 2))
           end do
-        end do
-      end do
-    else if (self%layout == BASIS_B9) then
-      call basis_b9_factors(self%t(1, p), self%inv_h(1), w1, g1, m1)
-      call basis_b9_factors(self%t(2, p), self%inv_h(2), w2, g2, m2)
-      if (size(node) < m1 * m2 .or. size(N) < m1 * m2 .or. size(dN, 1) < 2 .or. &
-          size(dN, 2) < m1 * m2) return
-      ! The node lists' order and products (x fastest; shape_tp_store).
-      do b = 1, m2
-        do a = 1, m1
-          nn = nn + 1
-          node(nn) = self%cell(p) + (a - 1) + self%stride * (b - 1)
-          N(nn) = w1(a) * w2(b)
-          dN(1, nn) = g1(a) * w2(b)
-          dN(2, nn) = g2(b) * w1(a)
         end do
       end do
     else if (self%layout == BASIS_Q4) then
@@ -336,22 +349,35 @@ contains
 
   include 'empm_q4_weights.inc'
 
-  !> The quadratic B-spline factors of the BASIS_B9 layout along one direction at the local
-  !> coordinate t ∈ [0.5, 1.5) with 1/h = `ih` (those of empm_b9_weights.inc, which the B9
-  !> transfers include too), and the number `m` of nodes the node lists keep: 2 when the third
-  !> node's value is exactly zero, otherwise 3.
-  pure subroutine basis_b9_factors(t, ih, w, g, m)
-    real(wp), intent(in) :: t         !! local coordinate, in [0.5, 1.5)
+  !> The 1D factors of a compact stencil layout along one direction (those of
+  !> empm_stencil_weights.inc, which the stencil transfers include too), and the stencil nodes
+  !> k0..k1 (of 1..3) the node lists keep: quadratic B-splines (BASIS_B9, BASIS_B27) at the
+  !> local coordinate t ∈ [0.5, 1.5), dropping the third node where its value is exactly zero;
+  !> uGIMP (BASIS_G9, BASIS_G27) at t ∈ [−0.5, 0.5] with half-length `el` cells, dropping the
+  !> end nodes beyond the support (r ≥ 1 + el).
+  pure subroutine basis_stencil_factors(layout, t, el, ih, w, g, k0, k1)
+    integer, intent(in) :: layout     !! BASIS_B9, BASIS_B27, BASIS_G9 or BASIS_G27
+    real(wp), intent(in) :: t         !! local coordinate
+    real(wp), intent(in) :: el        !! uGIMP: half-length in cells (unused otherwise)
     real(wp), intent(in) :: ih        !! 1/h along the direction
     real(wp), intent(out) :: w(3)     !! values
     real(wp), intent(out) :: g(3)     !! derivatives with respect to x
-    integer, intent(out) :: m         !! nodes with a value the node lists keep (2 or 3)
-    call b9_factors(t, ih, w, g)
-    ! bspline_1d drops the node where r = |t − 2| reaches the support radius 1.5.
-    m = merge(2, 3, 2.0_wp - t >= 1.5_wp)
-  end subroutine basis_b9_factors
+    integer, intent(out) :: k0        !! first stencil node the node lists keep
+    integer, intent(out) :: k1        !! last one
+    k0 = 1; k1 = 3
+    if (layout == BASIS_G9 .or. layout == BASIS_G27) then
+      call g9_factors(t, el, ih, w, g)
+      ! ugimp_1d drops a node at r = |t − k| ≥ 1 + el: only the end ones can be.
+      if (abs(t + 1.0_wp) >= 1.0_wp + el) k0 = 2
+      if (abs(t - 1.0_wp) >= 1.0_wp + el) k1 = 2
+    else
+      call b9_factors(t, ih, w, g)
+      ! bspline_1d drops the node where r = |t − 2| reaches the support radius 1.5.
+      if (2.0_wp - t >= 1.5_wp) k1 = 2
+    end if
+  end subroutine basis_stencil_factors
 
-  include 'empm_b9_weights.inc'
+  include 'empm_stencil_weights.inc'
 
   !> Human-readable text for a SHAPE_* status code.
   pure function shape_status_text(info) result(s)

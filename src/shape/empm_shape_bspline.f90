@@ -28,8 +28,8 @@
 !>
 !> **Compact layout.** The uniform quadratic family fills `BASIS_B9` on a 2D grid and
 !> `BASIS_B27` on a 3D one (per particle the first node of its 3^ndim stencil and ndim local
-!> coordinates; [[empm_basis_t]]), whose transfers recompute the values ([[empm_transfer_b9]],
-!> [[empm_transfer_b27]]). A particle whose stencil is not
+!> coordinates; [[empm_basis_t]]), whose transfers recompute the values ([[empm_transfer_s9]],
+!> [[empm_transfer_s27]]). A particle whose stencil is not
 !> inside the grid (it is then within h/2 of a face: the node lists drop a node beyond the face
 !> whose value is zero or, within SHAPE_CLIP_TOL, nearly so, or fail with
 !> SHAPE_SUPPORT_CLIPPED) cannot be held by it: the batch then turns the storage into node
@@ -39,12 +39,13 @@ module empm_shape_bspline
   use empm_grid, only: empm_grid_t
   use empm_particles, only: empm_particles_t
   use empm_error, only: empm_error_t
-  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
+  use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
                         BASIS_LISTS, BASIS_B9, BASIS_B27
   use empm_shape_linear, only: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, &
-                               shape_batch_fits, shape_keep_first_failure, shape_tp_store
+                               shape_batch_fits, shape_keep_first_failure, shape_tp_store, &
+                               shape_stencil_batch
   implicit none
   private
   public :: empm_shape_bspline_t, shape_bspline_kernel
@@ -171,7 +172,7 @@ contains
     call shape_batch_fits(pts%np, basis, ibad, info, compact=self%layout(grid))
     if (info /= SHAPE_OK) return
     if (basis%layout == BASIS_B9 .or. basis%layout == BASIS_B27) then
-      if (compact_batch(grid, pts, basis, ibad, info)) return
+      if (shape_stencil_batch(grid, pts, .false., 0.0_wp, basis, ibad, info)) return
       ! A stencil reaches beyond the grid: node lists from now on (one allocation per run).
       call basis%alloc(grid%ndim, basis%maxn, basis%np, BASIS_LISTS, err)
       if (err%code /= 0) then
@@ -237,68 +238,6 @@ contains
     !$omp end parallel do
     if (ibad == huge(1)) ibad = 0
   end subroutine uniform_batch
-
-  !> The compact quadratic basis (BASIS_B9 in 2D, BASIS_B27 in 3D) at particles 1..pts%np,
-  !> located as `bspline_1d` locates them (s the position in cells, i₁ = ⌊s − ½⌋, t = s − i₁:
-  !> exact). False, with nothing reported, when some particle inside the grid has a stencil
-  !> that is not (the caller turns to node lists); otherwise true, `ibad` the first particle
-  !> outside the closed grid box (the test of grid%inside, which a NaN fails too) or 0.
-  logical function compact_batch(grid, pts, basis, ibad, info) result(held)
-    type(empm_grid_t), intent(in) :: grid           !! background grid (2D or 3D)
-    type(empm_particles_t), intent(in) :: pts       !! particles
-    type(empm_basis_t), intent(inout) :: basis      !! BASIS_B9 or BASIS_B27 storage
-    integer, intent(out) :: ibad                    !! first particle outside the grid, or 0
-    integer, intent(out) :: info                    !! SHAPE_OK or SHAPE_OUTSIDE_GRID
-    real(wp) :: o(3), e(3), ih(3), s, t(3)
-    integer :: nc, c, p0, p1, p, d, nd, i, id, id0, lim(3), str(3), iout
-    logical :: inside, fits
-    nd = grid%ndim
-    o = 0.0_wp; e = 0.0_wp; ih = 1.0_wp; lim = 0; str = 0; t = 0.0_wp
-    do d = 1, nd
-      o(d) = grid%origin(d); e(d) = grid%origin(d) + grid%ncell(d) * grid%h(d)
-      ih(d) = grid%inv_h(d); lim(d) = grid%ncell(d) - 2
-    end do
-    str(1) = 1; str(2) = grid%ln(1); str(3) = grid%ln(1) * grid%ln(2); id0 = grid%id0
-    basis%stride = str(2); basis%stride2 = str(3); basis%inv_h(1:nd) = ih(1:nd)
-    nc = empm_chunks(pts%np)
-    ibad = huge(1); iout = huge(1)
-    !$omp parallel do default(none) num_threads(nc) schedule(static, 1) &
-    !$omp   shared(nc, nd, pts, basis, o, e, ih, lim, str, id0) &
-    !$omp   private(p0, p1, p, d, s, i, id, t, inside, fits) reduction(min: ibad, iout) if(nc > 1)
-    do c = 0, nc - 1
-      call empm_chunk_bounds(pts%np, nc, c, p0, p1)
-      do p = p0, p1
-        inside = .true.
-        do d = 1, nd
-          if (.not. (pts%x(d, p) >= o(d) .and. pts%x(d, p) <= e(d))) inside = .false.
-        end do
-        if (.not. inside) then
-          ibad = min(ibad, p); cycle
-        end if
-        fits = .true.; id = id0
-        do d = 1, nd
-          s = (pts%x(d, p) - o(d)) * ih(d)
-          i = floor(s - 0.5_wp)
-          if (i < 0 .or. i > lim(d)) fits = .false.
-          id = id + str(d) * i
-          t(d) = s - i
-        end do
-        if (.not. fits) then
-          iout = min(iout, p); cycle
-        end if
-        basis%cell(p) = id
-        basis%t(1:nd, p) = t(1:nd)
-      end do
-    end do
-    !$omp end parallel do
-    held = iout == huge(1)
-    info = SHAPE_OK
-    if (ibad == huge(1)) then
-      ibad = 0
-    else
-      info = SHAPE_OUTSIDE_GRID
-    end if
-  end function compact_batch
 
   !> B-spline shape functions of degree `order` at one point; only nodes with a nonzero value
   !> are returned, in increasing index order.

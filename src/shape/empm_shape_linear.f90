@@ -13,11 +13,13 @@ module empm_shape_linear
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
-                        BASIS_LISTS, BASIS_Q4, basis_q4_weights
+                        BASIS_LISTS, BASIS_Q4, BASIS_G9, BASIS_G27, basis_q4_weights, &
+                        basis_stencil_factors
   implicit none
   private
   public :: empm_shape_linear_t, shape_linear_kernel
-  public :: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, shape_batch_fits
+  public :: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, shape_batch_fits, &
+            shape_stencil_batch
   public :: shape_keep_first_failure, shape_tp_store
 
   !> Most nodes per direction of any tensor-product family (cubic B-spline).
@@ -424,6 +426,9 @@ contains
       end if
       if (.not. allocated(basis%cell)) then
         ibad = 1
+      else if (basis%layout == BASIS_G9 .or. basis%layout == BASIS_G27) then
+        if (size(basis%cell) < np .or. size(basis%wg, 4) < np) &
+          ibad = min(size(basis%cell), size(basis%wg, 4)) + 1
       else if (size(basis%cell) < np .or. size(basis%t, 2) < np) then
         ibad = min(size(basis%cell), size(basis%t, 2)) + 1
       end if
@@ -435,6 +440,94 @@ contains
     end if
     if (ibad /= 0) info = SHAPE_TOO_MANY_NODES
   end subroutine shape_batch_fits
+
+  !> A compact stencil basis at particles 1..pts%np (BASIS_B9, BASIS_B27 for the quadratic
+  !> B-splines; BASIS_G9, BASIS_G27 for uGIMP, `gimp`), each particle located as the family's
+  !> 1D routine locates it, with s the position in cells:
+  !> - B-splines (`bspline_1d`): first node i₁ = ⌊s − ½⌋, t = s − i₁;
+  !> - uGIMP (`ugimp_1d`): nearest node c = nint(s), first node c − 1, t = s − c, and the
+  !>   half-length el = lp/h (at most `el_max`, then min(el, ½), as `ugimp_1d` takes it); the
+  !>   1D factors are computed here and stored.
+  !> t is exact either way. False, with nothing reported, when some particle inside the grid
+  !> cannot be held (a stencil node beyond the grid; uGIMP: el not in (0, el_max]): the caller
+  !> turns to node lists, which give that particle's own result or failure. Otherwise true,
+  !> `ibad` the first particle outside the closed grid box (the test of grid%inside, which a NaN
+  !> fails too) or 0.
+  logical function shape_stencil_batch(grid, pts, gimp, el_max, basis, ibad, info) result(held)
+    type(empm_grid_t), intent(in) :: grid           !! background grid (2D or 3D)
+    type(empm_particles_t), intent(in) :: pts       !! particles
+    logical, intent(in) :: gimp                     !! uGIMP (else quadratic B-splines)
+    real(wp), intent(in) :: el_max                  !! uGIMP: largest half-length in cells
+    type(empm_basis_t), intent(inout) :: basis      !! compact stencil storage
+    integer, intent(out) :: ibad                    !! first particle outside the grid, or 0
+    integer, intent(out) :: info                    !! SHAPE_OK or SHAPE_OUTSIDE_GRID
+    real(wp) :: o(3), e(3), ih(3), s, t(3), el, wg(3, 2, 3)
+    integer :: nc, c, p0, p1, p, d, nd, i, id, id0, lim(3), str(3), iout, k0, k1
+    logical :: inside, fits
+    nd = grid%ndim
+    o = 0.0_wp; e = 0.0_wp; ih = 1.0_wp; lim = 0; str = 0; t = 0.0_wp; el = 0.0_wp; wg = 0.0_wp
+    do d = 1, nd
+      o(d) = grid%origin(d); e(d) = grid%origin(d) + grid%ncell(d) * grid%h(d)
+      ih(d) = grid%inv_h(d); lim(d) = grid%ncell(d) - 2
+    end do
+    str(1) = 1; str(2) = grid%ln(1); str(3) = grid%ln(1) * grid%ln(2); id0 = grid%id0
+    basis%stride = str(2); basis%stride2 = str(3); basis%inv_h(1:nd) = ih(1:nd)
+    nc = empm_chunks(pts%np)
+    ibad = huge(1); iout = huge(1)
+    !$omp parallel do default(none) num_threads(nc) schedule(static, 1) &
+    !$omp   shared(nc, nd, pts, basis, gimp, el_max, o, e, ih, lim, str, id0) &
+    !$omp   private(p0, p1, p, d, s, i, id, t, el, wg, k0, k1, inside, fits) &
+    !$omp   reduction(min: ibad, iout) &
+    !$omp   if(nc > 1)
+    do c = 0, nc - 1
+      call empm_chunk_bounds(pts%np, nc, c, p0, p1)
+      do p = p0, p1
+        inside = .true.
+        do d = 1, nd
+          if (.not. (pts%x(d, p) >= o(d) .and. pts%x(d, p) <= e(d))) inside = .false.
+        end do
+        if (.not. inside) then
+          ibad = min(ibad, p); cycle
+        end if
+        fits = .true.; id = id0
+        if (gimp) then
+          do d = 1, nd
+            s = (pts%x(d, p) - o(d)) * ih(d)
+            el = pts%lp(d, p) * ih(d)
+            if (.not. (el > 0.0_wp .and. el <= el_max)) fits = .false.
+            el = min(el, 0.5_wp)
+            i = nint(s) - 1
+            t(d) = s - (i + 1)
+            call basis_stencil_factors(BASIS_G9, t(d), el, ih(d), wg(:, 1, d), wg(:, 2, d), k0, k1)
+            if (i < 0 .or. i > lim(d)) fits = .false.
+            id = id + str(d) * i
+          end do
+          if (fits) basis%wg(:, :, 1:nd, p) = wg(:, :, 1:nd)
+        else
+          do d = 1, nd
+            s = (pts%x(d, p) - o(d)) * ih(d)
+            i = floor(s - 0.5_wp)
+            t(d) = s - i
+            if (i < 0 .or. i > lim(d)) fits = .false.
+            id = id + str(d) * i
+          end do
+          if (fits) basis%t(1:nd, p) = t(1:nd)
+        end if
+        if (.not. fits) then
+          iout = min(iout, p); cycle
+        end if
+        basis%cell(p) = id
+      end do
+    end do
+    !$omp end parallel do
+    held = iout == huge(1)
+    info = SHAPE_OK
+    if (ibad == huge(1)) then
+      ibad = 0
+    else
+      info = SHAPE_OUTSIDE_GRID
+    end if
+  end function shape_stencil_batch
 
   !> In a particle-parallel batch loop, after particle `p` failed with `pinfo`: keep the lowest
   !> failing particle and its code, as a serial loop would report. `ibad` starts at huge(1).

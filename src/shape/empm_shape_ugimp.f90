@@ -19,15 +19,25 @@
 !> Only nodes with a nonzero value are returned, so a point whose fractional cell position t
 !> (per direction, in [0,1)) and L = lp/h satisfy L ≤ t ≤ 1 − L has 2 nodes in that direction,
 !> otherwise 3.
+!>
+!> **Compact layout.** On 2D and 3D grids the family fills `BASIS_G9` / `BASIS_G27` (per
+!> particle the first node of its 3^ndim stencil, ndim local coordinates and ndim half-lengths
+!> in cells; [[empm_basis_t]]), whose transfers recompute the values ([[empm_transfer_s9]],
+!> [[empm_transfer_s27]]). A particle the layout cannot hold (a stencil node beyond the grid,
+!> or lp outside (0, h/2]) turns the storage into node lists, once, with their results and
+!> failures.
 module empm_shape_ugimp
   use empm_kinds, only: wp
   use empm_grid, only: empm_grid_t
   use empm_particles, only: empm_particles_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
+  use empm_error, only: empm_error_t
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
-                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES
+                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
+                        BASIS_LISTS, BASIS_G9, BASIS_G27
   use empm_shape_linear, only: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, &
-                               shape_batch_fits, shape_keep_first_failure, shape_tp_store
+                               shape_batch_fits, shape_keep_first_failure, shape_tp_store, &
+                               shape_stencil_batch
   implicit none
   private
   public :: empm_shape_ugimp_t, shape_ugimp_kernel
@@ -45,6 +55,7 @@ module empm_shape_ugimp
     procedure :: family => ugimp_family
     procedure :: summary => ugimp_summary
     procedure :: padding_cells => ugimp_padding_cells
+    procedure :: layout => ugimp_layout
   end type empm_shape_ugimp_t
 
 contains
@@ -116,9 +127,18 @@ contains
     integer :: p, pinfo
     real(wp) :: w(3, 3), g(3, 3)
     integer :: m(3), base(3), d
-    associate (unused_ => self); end associate
-    call shape_batch_fits(pts%np, basis, ibad, info)
+    type(empm_error_t) :: err
+    call shape_batch_fits(pts%np, basis, ibad, info, compact=self%layout(grid))
     if (info /= SHAPE_OK) return
+    if (basis%layout == BASIS_G9 .or. basis%layout == BASIS_G27) then
+      if (shape_stencil_batch(grid, pts, .true., 0.5_wp * (1.0_wp + LP_TOL), basis, ibad, info)) &
+        return
+      ! A particle the stencil cannot hold: node lists from now on (one allocation per run).
+      call basis%alloc(grid%ndim, basis%maxn, basis%np, BASIS_LISTS, err)
+      if (err%code /= 0) then
+        ibad = 1; info = SHAPE_BAD_LAYOUT; return
+      end if
+    end if
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
     if (grid%ndim >= 2 .and. size(basis%dN, 1) >= grid%ndim) then
@@ -157,6 +177,17 @@ contains
     end if
     if (ibad == huge(1)) ibad = 0
   end subroutine ugimp_eval_batch
+
+  !> Basis layout: BASIS_G9 on a 2D grid, BASIS_G27 on a 3D one (the first node of the 3^ndim
+  !> stencil, ndim local coordinates and half-lengths per particle), node lists otherwise.
+  pure integer function ugimp_layout(self, grid)
+    class(empm_shape_ugimp_t), intent(in) :: self !! shape family
+    type(empm_grid_t), intent(in) :: grid         !! background grid
+    associate (unused_ => self); end associate
+    ugimp_layout = BASIS_LISTS
+    if (grid%ndim == 2) ugimp_layout = BASIS_G9
+    if (grid%ndim == 3) ugimp_layout = BASIS_G27
+  end function ugimp_layout
 
   !> uGIMP shape functions at one point; only nodes with a nonzero value are returned,
   !> in increasing index order.

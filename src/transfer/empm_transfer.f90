@@ -18,16 +18,16 @@
 !> every P2G kernel; what it accumulates is selected once per particle range ([[p2g_range]]).
 !>
 !> Every kernel dispatches on the basis layout and dimension once per particle chunk: the
-!> compact bilinear layout (`BASIS_Q4`) goes to [[empm_transfer_q4]], the compact quadratic
-!> B-spline ones to [[empm_transfer_b9]] (`BASIS_B9`, 2D) and [[empm_transfer_b27]]
-!> (`BASIS_B27`, 3D); node lists in 2D to the
+!> compact bilinear layout (`BASIS_Q4`) goes to [[empm_transfer_q4]], the compact 3^ndim
+!> stencils of quadratic B-splines and uGIMP to [[empm_transfer_s9]] (`BASIS_B9`, `BASIS_G9`:
+!> 2D) and [[empm_transfer_s27]] (`BASIS_B27`, `BASIS_G27`: 3D); node lists in 2D to the
 !> specialised loops of [[empm_transfer_2d]] for the kernels of the time step (mass +
 !> momentum, internal force, G2P, velocity gradient); everything else to the generic loops
 !> here. All paths do the same arithmetic in the same order (same bits). Nodal and particle
 !> arrays must be contiguous.
 module empm_transfer
   use empm_kinds, only: wp
-  use empm_shape, only: empm_basis_t, BASIS_Q4, BASIS_B9, BASIS_B27
+  use empm_shape, only: empm_basis_t, BASIS_Q4, BASIS_B9, BASIS_B27, BASIS_G9, BASIS_G27
   use empm_nodes, only: empm_nodes_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_transfer_2d, only: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, &
@@ -35,10 +35,10 @@ module empm_transfer
   use empm_transfer_3d, only: internal_force_3d, velocity_gradient_3d, g2p_3d
   use empm_transfer_q4, only: mass_q4, weighted_q4, mass_momentum_q4, body_force_q4, &
                               internal_force_q4, velocity_gradient_q4, g2p_q4
-  use empm_transfer_b9, only: mass_b9, weighted_b9, mass_momentum_b9, body_force_b9, &
-                              internal_force_b9, velocity_gradient_b9, g2p_b9
-  use empm_transfer_b27, only: mass_b27, weighted_b27, mass_momentum_b27, body_force_b27, &
-                               internal_force_b27, velocity_gradient_b27, g2p_b27
+  use empm_transfer_s9, only: mass_s9, weighted_s9, mass_momentum_s9, body_force_s9, &
+                              internal_force_s9, velocity_gradient_s9, g2p_s9
+  use empm_transfer_s27, only: mass_s27, weighted_s27, mass_momentum_s27, body_force_s27, &
+                               internal_force_s27, velocity_gradient_s27, g2p_s27
   implicit none
   private
   public :: empm_p2g_work_t
@@ -126,14 +126,14 @@ contains
           lo = min(lo, basis%cell(p)); hi = max(hi, basis%cell(p) + basis%stride + 1)
         end do
         !$omp end parallel do
-      else if (basis%layout == BASIS_B9) then
+      else if (is_s9(basis)) then
         !$omp parallel do num_threads(self%nt) schedule(static) default(none) &
         !$omp   shared(basis, p0, p1) reduction(min: lo) reduction(max: hi)
         do p = p0, p1
           lo = min(lo, basis%cell(p)); hi = max(hi, basis%cell(p) + 2 * basis%stride + 2)
         end do
         !$omp end parallel do
-      else if (basis%layout == BASIS_B27) then
+      else if (is_s27(basis)) then
         !$omp parallel do num_threads(self%nt) schedule(static) default(none) &
         !$omp   shared(basis, p0, p1) reduction(min: lo) reduction(max: hi)
         do p = p0, p1
@@ -400,11 +400,13 @@ contains
     if (basis%layout == BASIS_Q4) then
       call mass_q4(basis%stride, p0, p1, basis%cell, basis%t, m, mass); return
     end if
-    if (basis%layout == BASIS_B9) then
-      call mass_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, m, mass); return
+    if (is_s9(basis)) then
+      call mass_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                   basis%layout == BASIS_G9, basis%wg, m, mass); return
     end if
-    if (basis%layout == BASIS_B27) then
-      call mass_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, m, mass); return
+    if (is_s27(basis)) then
+      call mass_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                    basis%layout == BASIS_G27, basis%wg, m, mass); return
     end if
     do p = p0, p1
       do k = 1, basis%nn(p)
@@ -428,12 +430,14 @@ contains
     if (basis%layout == BASIS_Q4) then
       call weighted_q4(basis%stride, p0, p1, basis%cell, basis%t, m, u, c, w, q); return
     end if
-    if (basis%layout == BASIS_B9) then
-      call weighted_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, m, u, c, w, q)
+    if (is_s9(basis)) then
+      call weighted_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                       basis%layout == BASIS_G9, basis%wg, m, u, c, w, q)
       return
     end if
-    if (basis%layout == BASIS_B27) then
-      call weighted_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, m, u, c, w, q)
+    if (is_s27(basis)) then
+      call weighted_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                        basis%layout == BASIS_G27, basis%wg, m, u, c, w, q)
       return
     end if
     d = size(u, 1)
@@ -463,11 +467,13 @@ contains
     real(wp), intent(inout), contiguous :: q(:,:)        !! nodal vectors (ndim, nnode), accumulated
     if (basis%layout == BASIS_Q4) then
       call mass_momentum_q4(basis%stride, p0, p1, basis%cell, basis%t, m, u, c, w, mass, q)
-    else if (basis%layout == BASIS_B9) then
-      call mass_momentum_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, m, u, c, w, &
+    else if (is_s9(basis)) then
+      call mass_momentum_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                            basis%layout == BASIS_G9, basis%wg, m, u, c, w, &
                             mass, q)
-    else if (basis%layout == BASIS_B27) then
-      call mass_momentum_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, m, u, c, w, mass, q)
+    else if (is_s27(basis)) then
+      call mass_momentum_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                             basis%layout == BASIS_G27, basis%wg, m, u, c, w, mass, q)
     else if (basis%ndim == 2) then
       call mass_momentum_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, m, u, c, w, &
                             mass, q)
@@ -493,13 +499,15 @@ contains
                              stress, f)
       return
     end if
-    if (basis%layout == BASIS_B9) then
-      call internal_force_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, vol, &
+    if (is_s9(basis)) then
+      call internal_force_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                             basis%layout == BASIS_G9, basis%wg, vol, &
                              stress, f)
       return
     end if
-    if (basis%layout == BASIS_B27) then
-      call internal_force_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, vol, stress, f)
+    if (is_s27(basis)) then
+      call internal_force_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                              basis%layout == BASIS_G27, basis%wg, vol, stress, f)
       return
     end if
     if (d == 2) then
@@ -545,13 +553,15 @@ contains
     if (basis%layout == BASIS_Q4) then
       call body_force_q4(basis%stride, p0, p1, basis%cell, basis%t, m, g, b, use_b, f); return
     end if
-    if (basis%layout == BASIS_B9) then
-      call body_force_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, m, g, b, use_b, &
+    if (is_s9(basis)) then
+      call body_force_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                         basis%layout == BASIS_G9, basis%wg, m, g, b, use_b, &
                          f)
       return
     end if
-    if (basis%layout == BASIS_B27) then
-      call body_force_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, m, g, b, use_b, f)
+    if (is_s27(basis)) then
+      call body_force_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                          basis%layout == BASIS_G27, basis%wg, m, g, b, use_b, f)
       return
     end if
     d = size(g)
@@ -565,6 +575,18 @@ contains
       end do
     end do
   end subroutine body_range
+
+  !> Whether `basis` has a compact 3 × 3 stencil layout (2D quadratic B-splines or uGIMP).
+  pure logical function is_s9(basis)
+    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
+    is_s9 = basis%layout == BASIS_B9 .or. basis%layout == BASIS_G9
+  end function is_s9
+
+  !> Whether `basis` has a compact 3 × 3 × 3 stencil layout (3D quadratic B-splines or uGIMP).
+  pure logical function is_s27(basis)
+    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
+    is_s27 = basis%layout == BASIS_B27 .or. basis%layout == BASIS_G27
+  end function is_s27
 
   !> Interpolate a nodal vector to the particles: u_p = Σ_I N_Ip q_I.
   subroutine g2p_value(basis, q, u)
@@ -581,12 +603,14 @@ contains
         call g2p_q4(basis%stride, p0, p1, basis%cell, basis%t, q, .false., 0.0_wp, u)
         cycle
       end if
-      if (basis%layout == BASIS_B9) then
-        call g2p_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, q, .false., 0.0_wp, u)
+      if (is_s9(basis)) then
+        call g2p_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                    basis%layout == BASIS_G9, basis%wg, q, .false., 0.0_wp, u)
         cycle
       end if
-      if (basis%layout == BASIS_B27) then
-        call g2p_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, q, .false., 0.0_wp, u)
+      if (is_s27(basis)) then
+        call g2p_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                     basis%layout == BASIS_G27, basis%wg, q, .false., 0.0_wp, u)
         cycle
       end if
       if (basis%ndim == 2) then
@@ -625,12 +649,14 @@ contains
       call g2p_q4(basis%stride, p0, p1, basis%cell, basis%t, q, .true., c, u)
       return
     end if
-    if (basis%layout == BASIS_B9) then
-      call g2p_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, q, .true., c, u)
+    if (is_s9(basis)) then
+      call g2p_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                  basis%layout == BASIS_G9, basis%wg, q, .true., c, u)
       return
     end if
-    if (basis%layout == BASIS_B27) then
-      call g2p_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, q, .true., c, u)
+    if (is_s27(basis)) then
+      call g2p_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                   basis%layout == BASIS_G27, basis%wg, q, .true., c, u)
       return
     end if
     if (d == 2) then
@@ -686,12 +712,14 @@ contains
       call velocity_gradient_q4(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, v, L)
       return
     end if
-    if (basis%layout == BASIS_B9) then
-      call velocity_gradient_b9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, v, L)
+    if (is_s9(basis)) then
+      call velocity_gradient_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                                basis%layout == BASIS_G9, basis%wg, v, L)
       return
     end if
-    if (basis%layout == BASIS_B27) then
-      call velocity_gradient_b27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, v, L)
+    if (is_s27(basis)) then
+      call velocity_gradient_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                                 basis%layout == BASIS_G27, basis%wg, v, L)
       return
     end if
     if (d == 2) then

@@ -1,33 +1,33 @@
-!> Transfer kernels on the compact quadratic B-spline basis in 3D (`BASIS_B27` of
-!> [[empm_basis_t]]): per particle the first node `id` of its 3 × 3 × 3 stencil and the local
-!> coordinates (t1, t2, t3); the nodes are id + a + s·b + s2·c (a, b, c = 0, 1, 2; s = nodes
-!> along x, s2 = nodes per x-y plane) and the values and gradients are recomputed here:
-!> 3 + 3 + 3 one-dimensional factors, then their products.
+!> Transfer kernels on the compact 3 × 3 × 3 stencils of a 3D grid (`BASIS_B27` and
+!> `BASIS_G27` of [[empm_basis_t]]): per particle the first node `id` of its stencil and the
+!> local coordinates (t1, t2, t3), with uGIMP the half-lengths in cells too; the nodes are
+!> id + a + s·b + s2·c (a, b, c = 0, 1, 2; s = nodes along x, s2 = nodes per x-y plane) and the
+!> values and gradients are recomputed here: 3 + 3 + 3 one-dimensional factors (quadratic
+!> B-spline or uGIMP, as in [[empm_transfer_s9]]), then their products.
 !>
-!> Why: the node lists of a 3D `bspline2` basis hold 972 B per particle, written by the shape
-!> phase and read by four passes a step; the compact layout holds 28 B. The factors are those
-!> of [[basis_b9_factors]] (src/shape/empm_b9_weights.inc, included so that it is inlined),
-!> the products those of the lists (`shape_tp_store`), and every kernel does the arithmetic of
-!> its node-list counterpart in [[empm_transfer_3d]] / [[empm_transfer]] in the same order; a
-!> zero-valued stencil node adds ±0, so the results are the lists', the sign of a zero aside
-!> (tests/unit/test_transfer_compact.pf). One particle at a time (`!GCC$ novector`), as in
-!> [[empm_transfer_b9]]. Arrays are explicit-shape and contiguous; kernels work on particles
-!> p0..p1.
-module empm_transfer_b27
+!> Why: the node lists of a 3D basis with 27 nodes hold 972 B per particle, written by the shape
+!> phase and read by four passes a step; the compact layouts hold 28 B (B-splines) or 52 B
+!> (uGIMP). The products are those of the lists (`shape_tp_store`), and every kernel does the
+!> arithmetic of its node-list counterpart in [[empm_transfer_3d]] / [[empm_transfer]] in the
+!> same order; a zero-valued stencil node adds ±0, so the results are the lists', the sign of
+!> a zero aside (tests/unit/test_transfer_compact.pf). One particle at a time
+!> (`!GCC$ novector`), as in [[empm_transfer_s9]]. Arrays are explicit-shape and contiguous;
+!> kernels work on particles p0..p1.
+module empm_transfer_s27
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   implicit none
   private
-  public :: mass_b27, weighted_b27, mass_momentum_b27, body_force_b27, internal_force_b27, &
-            velocity_gradient_b27, g2p_b27
+  public :: mass_s27, weighted_s27, mass_momentum_s27, body_force_s27, internal_force_s27, &
+            velocity_gradient_s27, g2p_s27
 
 contains
 
-  ! b9_factors: the one text of the quadratic B-spline factors (src/shape).
-  include '../shape/empm_b9_weights.inc'
+  ! b9_factors, g9_factors: the one text of the stencils' 1D factors (src/shape).
+  include '../shape/empm_stencil_weights.inc'
 
   !> m_I += Σ N_Ip m_p.
-  pure subroutine mass_b27(s, s2, h, p0, p1, cell, t, m, mass)
+  pure subroutine mass_s27(s, s2, h, p0, p1, cell, t, gimp, wg, m, mass)
     integer, intent(in) :: s                 !! nodes along x
     integer, intent(in) :: s2                !! nodes per x-y plane
     real(wp), intent(in) :: h(3)             !! 1/h per direction
@@ -35,6 +35,8 @@ contains
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(3, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 3, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: m(*)             !! particle masses
     real(wp), intent(inout) :: mass(*)       !! nodal masses (accumulated)
     real(wp) :: w(3, 3), g(3, 3), w23
@@ -42,9 +44,13 @@ contains
     integer(int64) :: I ! 64-bit: the neighbours' addresses are offsets of the first node's
     !GCC$ novector
     do p = p0, p1
-      call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
-      call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
-      call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      if (gimp) then
+        w = wg(:, 1, :, p); g = wg(:, 2, :, p)
+      else
+        call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
+        call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
+        call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      end if
       do c = 1, 3
         do b = 1, 3
           w23 = w(b, 2) * w(c, 3)
@@ -56,10 +62,10 @@ contains
         end do
       end do
     end do
-  end subroutine mass_b27
+  end subroutine mass_s27
 
   !> q_I += Σ N_Ip m_p (u_p + c w_p) (cw = 0 ignores w).
-  pure subroutine weighted_b27(s, s2, h, p0, p1, cell, t, m, u, cw, w, q)
+  pure subroutine weighted_s27(s, s2, h, p0, p1, cell, t, gimp, wg, m, u, cw, w, q)
     integer, intent(in) :: s                 !! nodes along x
     integer, intent(in) :: s2                !! nodes per x-y plane
     real(wp), intent(in) :: h(3)             !! 1/h per direction
@@ -67,6 +73,8 @@ contains
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(3, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 3, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: m(*)             !! particle masses
     real(wp), intent(in) :: u(3, *)          !! particle vectors
     real(wp), intent(in) :: cw               !! scale of `w`
@@ -82,9 +90,13 @@ contains
       else
         mu = m(p) * (u(:, p) + cw * w(:, p))
       end if
-      call b9_factors(t(1, p), h(1), wf(:, 1), g(:, 1))
-      call b9_factors(t(2, p), h(2), wf(:, 2), g(:, 2))
-      call b9_factors(t(3, p), h(3), wf(:, 3), g(:, 3))
+      if (gimp) then
+        wf = wg(:, 1, :, p); g = wg(:, 2, :, p)
+      else
+        call b9_factors(t(1, p), h(1), wf(:, 1), g(:, 1))
+        call b9_factors(t(2, p), h(2), wf(:, 2), g(:, 2))
+        call b9_factors(t(3, p), h(3), wf(:, 3), g(:, 3))
+      end if
       do c = 1, 3
         do b = 1, 3
           w23 = wf(b, 2) * wf(c, 3)
@@ -96,10 +108,10 @@ contains
         end do
       end do
     end do
-  end subroutine weighted_b27
+  end subroutine weighted_s27
 
   !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (cw = 0 ignores w).
-  pure subroutine mass_momentum_b27(s, s2, h, p0, p1, cell, t, m, u, cw, w, mass, q)
+  pure subroutine mass_momentum_s27(s, s2, h, p0, p1, cell, t, gimp, wg, m, u, cw, w, mass, q)
     integer, intent(in) :: s                 !! nodes along x
     integer, intent(in) :: s2                !! nodes per x-y plane
     real(wp), intent(in) :: h(3)             !! 1/h per direction
@@ -107,6 +119,8 @@ contains
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(3, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 3, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: m(*)             !! particle masses
     real(wp), intent(in) :: u(3, *)          !! particle vectors
     real(wp), intent(in) :: cw               !! scale of `w`
@@ -123,9 +137,13 @@ contains
       else
         mu = m(p) * (u(:, p) + cw * w(:, p))
       end if
-      call b9_factors(t(1, p), h(1), wf(:, 1), g(:, 1))
-      call b9_factors(t(2, p), h(2), wf(:, 2), g(:, 2))
-      call b9_factors(t(3, p), h(3), wf(:, 3), g(:, 3))
+      if (gimp) then
+        wf = wg(:, 1, :, p); g = wg(:, 2, :, p)
+      else
+        call b9_factors(t(1, p), h(1), wf(:, 1), g(:, 1))
+        call b9_factors(t(2, p), h(2), wf(:, 2), g(:, 2))
+        call b9_factors(t(3, p), h(3), wf(:, 3), g(:, 3))
+      end if
       do c = 1, 3
         do b = 1, 3
           w23 = wf(b, 2) * wf(c, 3)
@@ -139,10 +157,10 @@ contains
         end do
       end do
     end do
-  end subroutine mass_momentum_b27
+  end subroutine mass_momentum_s27
 
   !> f_I += Σ N_Ip m_p (g + b_p) (b only with `use_b`).
-  pure subroutine body_force_b27(s, s2, h, p0, p1, cell, t, m, ga, bf, use_b, f)
+  pure subroutine body_force_s27(s, s2, h, p0, p1, cell, t, gimp, wg, m, ga, bf, use_b, f)
     integer, intent(in) :: s                 !! nodes along x
     integer, intent(in) :: s2                !! nodes per x-y plane
     real(wp), intent(in) :: h(3)             !! 1/h per direction
@@ -150,6 +168,8 @@ contains
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(3, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 3, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: m(*)             !! particle masses
     real(wp), intent(in) :: ga(3)            !! uniform acceleration
     real(wp), intent(in) :: bf(3, *)         !! body force per unit mass (with `use_b`)
@@ -163,9 +183,13 @@ contains
       fp = ga
       if (use_b) fp = fp + bf(:, p)
       fp = m(p) * fp
-      call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
-      call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
-      call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      if (gimp) then
+        w = wg(:, 1, :, p); g = wg(:, 2, :, p)
+      else
+        call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
+        call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
+        call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      end if
       do c = 1, 3
         do b = 1, 3
           w23 = w(b, 2) * w(c, 3)
@@ -177,10 +201,10 @@ contains
         end do
       end do
     end do
-  end subroutine body_force_b27
+  end subroutine body_force_s27
 
   !> f_I −= Σ V_p σ_p ∇N_Ip (σ in Voigt order: xx, yy, zz, yz, xz, xy).
-  pure subroutine internal_force_b27(s, s2, h, p0, p1, cell, t, vol, stress, f)
+  pure subroutine internal_force_s27(s, s2, h, p0, p1, cell, t, gimp, wg, vol, stress, f)
     integer, intent(in) :: s                 !! nodes along x
     integer, intent(in) :: s2                !! nodes per x-y plane
     real(wp), intent(in) :: h(3)             !! 1/h per direction
@@ -188,6 +212,8 @@ contains
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(3, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 3, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: vol(*)           !! particle volumes
     real(wp), intent(in) :: stress(6, *)     !! Cauchy stresses
     real(wp), intent(inout) :: f(3, *)       !! nodal forces (accumulated)
@@ -201,9 +227,13 @@ contains
       sv(1, 3) = stress(5, p); sv(3, 1) = stress(5, p)
       sv(1, 2) = stress(6, p); sv(2, 1) = stress(6, p)
       sv = vol(p) * sv
-      call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
-      call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
-      call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      if (gimp) then
+        w = wg(:, 1, :, p); g = wg(:, 2, :, p)
+      else
+        call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
+        call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
+        call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      end if
       do c = 1, 3
         do b = 1, 3
           I = cell(p) + int(s, int64) * (b - 1) + int(s2, int64) * (c - 1)
@@ -221,10 +251,10 @@ contains
         end do
       end do
     end do
-  end subroutine internal_force_b27
+  end subroutine internal_force_s27
 
   !> L_p = Σ v_I ⊗ ∇N_Ip, the full 3×3 gradient, into L(:, :, 1..p1−p0+1).
-  pure subroutine velocity_gradient_b27(s, s2, h, p0, p1, cell, t, v, L)
+  pure subroutine velocity_gradient_s27(s, s2, h, p0, p1, cell, t, gimp, wg, v, L)
     integer, intent(in) :: s                 !! nodes along x
     integer, intent(in) :: s2                !! nodes per x-y plane
     real(wp), intent(in) :: h(3)             !! 1/h per direction
@@ -232,6 +262,8 @@ contains
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(3, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 3, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: v(3, *)          !! nodal velocities
     real(wp), intent(inout) :: L(3, 3, *)    !! velocity gradients
     real(wp) :: w(3, 3), g(3, 3), lx(3), ly(3), lz(3)
@@ -239,9 +271,13 @@ contains
     integer(int64) :: I
     !GCC$ novector
     do p = p0, p1
-      call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
-      call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
-      call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      if (gimp) then
+        w = wg(:, 1, :, p); g = wg(:, 2, :, p)
+      else
+        call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
+        call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
+        call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      end if
       lx = 0.0_wp; ly = 0.0_wp; lz = 0.0_wp
       do c = 1, 3
         do b = 1, 3
@@ -256,10 +292,10 @@ contains
       end do
       L(:, 1, p - p0 + 1) = lx; L(:, 2, p - p0 + 1) = ly; L(:, 3, p - p0 + 1) = lz
     end do
-  end subroutine velocity_gradient_b27
+  end subroutine velocity_gradient_s27
 
   !> u_p = Σ N_Ip q_I, or with `add` u_p += c Σ N_Ip q_I.
-  pure subroutine g2p_b27(s, s2, h, p0, p1, cell, t, q, add, cs, u)
+  pure subroutine g2p_s27(s, s2, h, p0, p1, cell, t, gimp, wg, q, add, cs, u)
     integer, intent(in) :: s                 !! nodes along x
     integer, intent(in) :: s2                !! nodes per x-y plane
     real(wp), intent(in) :: h(3)             !! 1/h per direction
@@ -267,6 +303,8 @@ contains
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(3, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 3, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: q(3, *)          !! nodal vectors
     logical, intent(in) :: add               !! accumulate cs Σ N q instead of overwriting
     real(wp), intent(in) :: cs               !! scale (with `add`)
@@ -276,9 +314,13 @@ contains
     integer(int64) :: I
     !GCC$ novector
     do p = p0, p1
-      call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
-      call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
-      call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      if (gimp) then
+        w = wg(:, 1, :, p); g = wg(:, 2, :, p)
+      else
+        call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
+        call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
+        call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      end if
       sm = 0.0_wp
       do c = 1, 3
         do b = 1, 3
@@ -296,6 +338,6 @@ contains
         u(:, p) = sm
       end if
     end do
-  end subroutine g2p_b27
+  end subroutine g2p_s27
 
-end module empm_transfer_b27
+end module empm_transfer_s27

@@ -1,41 +1,46 @@
-!> Transfer kernels on the compact quadratic B-spline basis (`BASIS_B9` of [[empm_basis_t]]):
-!> per particle the first node `id` of its 3 × 3 stencil and the local coordinates (t1, t2);
-!> the nodes are id + a + s·b (a, b = 0, 1, 2; s = nodes along x) and the values and gradients
-!> are recomputed here from (t1, t2): 3 + 3 one-dimensional factors, then their products.
+!> Transfer kernels on the compact 3 × 3 stencils of a 2D grid (`BASIS_B9` and `BASIS_G9` of
+!> [[empm_basis_t]]): per particle the first node `id` of its stencil and the local coordinates
+!> (t1, t2), with uGIMP the half-lengths in cells (el1, el2) too; the nodes are id + a + s·b
+!> (a, b = 0, 1, 2; s = nodes along x) and the values and gradients are recomputed here: 3 + 3
+!> one-dimensional factors, quadratic B-spline ([[basis_stencil_factors]]: `b9_factors`) or
+!> uGIMP (`g9_factors`), then their products.
 !>
-!> Why: the node lists of a 2D `bspline2` basis hold 252 B per particle, written by the shape
-!> phase and read by four passes a step; the compact layout holds 20 B, and the fixed 3 × 3
-!> loops need no node count or index loads. The factors are the expressions of
-!> [[basis_b9_factors]], included from src/shape/empm_b9_weights.inc (one text, compiled into
-!> this file so that it is inlined), and every kernel does the same arithmetic in the same
-!> order as its node-list counterpart in [[empm_transfer_2d]] / [[empm_transfer]]. A stencil
-!> node whose value is exactly zero (the lists drop it) adds ±0 here: the results are those of
-!> the lists, the sign of a zero aside (tests/unit/test_transfer_b9.pf checks both). Arrays are
-!> explicit-shape and contiguous; kernels work on particles p0..p1. The particle loops are not
-!> vectorised (`!GCC$ novector`): across particles gfortran gathers the nine nodes' values
-!> pairwise and spills, which measured slower than one particle at a time (6 % on a whole
-!> 2D bspline2 bench run, 8 interleaved pairs).
-module empm_transfer_b9
+!> Why: the node lists of a 2D basis with 9 nodes hold 252 B per particle, written by the shape
+!> phase and read by four passes a step; the compact layouts hold 20 B (B-splines) or 36 B
+!> (uGIMP), and the fixed 3 × 3 loops need no node count or index loads. The factors are
+!> included from src/shape/empm_stencil_weights.inc (one text with [[basis_get]], compiled into
+!> this file so that it is inlined); every kernel does the same arithmetic in the same order as
+!> its node-list counterpart in [[empm_transfer_2d]] / [[empm_transfer]]. A stencil node whose
+!> value is exactly zero (the lists drop it) adds ±0 here: the results are those of the lists,
+!> the sign of a zero aside (tests/unit/test_transfer_compact.pf checks both). The family
+!> (`gimp`) is fixed for a call: its test is hoisted out of the particle loop by the compiler.
+!> Arrays are explicit-shape and contiguous; kernels work on particles p0..p1. The particle
+!> loops are not vectorised (`!GCC$ novector`): across particles gfortran gathers the nine
+!> nodes' values pairwise and spills, which measured slower than one particle at a time (6 % on
+!> a whole 2D bspline2 bench run, 8 interleaved pairs).
+module empm_transfer_s9
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
   implicit none
   private
-  public :: mass_b9, weighted_b9, mass_momentum_b9, body_force_b9, internal_force_b9, &
-            velocity_gradient_b9, g2p_b9
+  public :: mass_s9, weighted_s9, mass_momentum_s9, body_force_s9, internal_force_s9, &
+            velocity_gradient_s9, g2p_s9
 
 contains
 
-  ! b9_factors: the one text of the quadratic B-spline factors (src/shape).
-  include '../shape/empm_b9_weights.inc'
+  ! b9_factors, g9_factors: the one text of the stencils' 1D factors (src/shape).
+  include '../shape/empm_stencil_weights.inc'
 
   !> m_I += Σ N_Ip m_p.
-  pure subroutine mass_b9(s, h, p0, p1, cell, t, m, mass)
+  pure subroutine mass_s9(s, h, p0, p1, cell, t, gimp, wg, m, mass)
     integer, intent(in) :: s                 !! nodes along x
     real(wp), intent(in) :: h(2)             !! 1/h per direction
     integer, intent(in) :: p0                !! first particle
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(2, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 2, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: m(*)             !! particle masses
     real(wp), intent(inout) :: mass(*)       !! nodal masses (accumulated)
     real(wp) :: wx(3), gx(3), wy(3), gy(3)
@@ -43,8 +48,13 @@ contains
     integer(int64) :: I ! 64-bit: the neighbours' addresses are offsets of the first node's
     !GCC$ novector
     do p = p0, p1
-      call b9_factors(t(1, p), h(1), wx, gx)
-      call b9_factors(t(2, p), h(2), wy, gy)
+      if (gimp) then
+        wx = wg(:, 1, 1, p); gx = wg(:, 2, 1, p)
+        wy = wg(:, 1, 2, p); gy = wg(:, 2, 2, p)
+      else
+        call b9_factors(t(1, p), h(1), wx, gx)
+        call b9_factors(t(2, p), h(2), wy, gy)
+      end if
       do b = 1, 3
         I = cell(p) + int(s, int64) * (b - 1)
         do a = 1, 3
@@ -53,16 +63,18 @@ contains
         end do
       end do
     end do
-  end subroutine mass_b9
+  end subroutine mass_s9
 
   !> q_I += Σ N_Ip m_p (u_p + c w_p) (c = 0 ignores w).
-  pure subroutine weighted_b9(s, h, p0, p1, cell, t, m, u, c, w, q)
+  pure subroutine weighted_s9(s, h, p0, p1, cell, t, gimp, wg, m, u, c, w, q)
     integer, intent(in) :: s                 !! nodes along x
     real(wp), intent(in) :: h(2)             !! 1/h per direction
     integer, intent(in) :: p0                !! first particle
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(2, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 2, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: m(*)             !! particle masses
     real(wp), intent(in) :: u(2, *)          !! particle vectors
     real(wp), intent(in) :: c                !! scale of `w`
@@ -78,8 +90,13 @@ contains
       else
         mu = m(p) * (u(:, p) + c * w(:, p))
       end if
-      call b9_factors(t(1, p), h(1), wx, gx)
-      call b9_factors(t(2, p), h(2), wy, gy)
+      if (gimp) then
+        wx = wg(:, 1, 1, p); gx = wg(:, 2, 1, p)
+        wy = wg(:, 1, 2, p); gy = wg(:, 2, 2, p)
+      else
+        call b9_factors(t(1, p), h(1), wx, gx)
+        call b9_factors(t(2, p), h(2), wy, gy)
+      end if
       do b = 1, 3
         I = cell(p) + int(s, int64) * (b - 1)
         do a = 1, 3
@@ -88,16 +105,18 @@ contains
         end do
       end do
     end do
-  end subroutine weighted_b9
+  end subroutine weighted_s9
 
   !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (c = 0 ignores w).
-  pure subroutine mass_momentum_b9(s, h, p0, p1, cell, t, m, u, c, w, mass, q)
+  pure subroutine mass_momentum_s9(s, h, p0, p1, cell, t, gimp, wg, m, u, c, w, mass, q)
     integer, intent(in) :: s                 !! nodes along x
     real(wp), intent(in) :: h(2)             !! 1/h per direction
     integer, intent(in) :: p0                !! first particle
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(2, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 2, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: m(*)             !! particle masses
     real(wp), intent(in) :: u(2, *)          !! particle vectors
     real(wp), intent(in) :: c                !! scale of `w`
@@ -114,8 +133,13 @@ contains
       else
         mu = m(p) * (u(:, p) + c * w(:, p))
       end if
-      call b9_factors(t(1, p), h(1), wx, gx)
-      call b9_factors(t(2, p), h(2), wy, gy)
+      if (gimp) then
+        wx = wg(:, 1, 1, p); gx = wg(:, 2, 1, p)
+        wy = wg(:, 1, 2, p); gy = wg(:, 2, 2, p)
+      else
+        call b9_factors(t(1, p), h(1), wx, gx)
+        call b9_factors(t(2, p), h(2), wy, gy)
+      end if
       do b = 1, 3
         I = cell(p) + int(s, int64) * (b - 1)
         do a = 1, 3
@@ -126,16 +150,18 @@ contains
         end do
       end do
     end do
-  end subroutine mass_momentum_b9
+  end subroutine mass_momentum_s9
 
   !> f_I += Σ N_Ip m_p (g + b_p) (b only with `use_b`).
-  pure subroutine body_force_b9(s, h, p0, p1, cell, t, m, g, bf, use_b, f)
+  pure subroutine body_force_s9(s, h, p0, p1, cell, t, gimp, wg, m, g, bf, use_b, f)
     integer, intent(in) :: s                 !! nodes along x
     real(wp), intent(in) :: h(2)             !! 1/h per direction
     integer, intent(in) :: p0                !! first particle
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(2, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 2, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: m(*)             !! particle masses
     real(wp), intent(in) :: g(2)             !! uniform acceleration
     real(wp), intent(in) :: bf(2, *)         !! body force per unit mass (with `use_b`)
@@ -149,8 +175,13 @@ contains
       fp = g
       if (use_b) fp = fp + bf(:, p)
       fp = m(p) * fp
-      call b9_factors(t(1, p), h(1), wx, gx)
-      call b9_factors(t(2, p), h(2), wy, gy)
+      if (gimp) then
+        wx = wg(:, 1, 1, p); gx = wg(:, 2, 1, p)
+        wy = wg(:, 1, 2, p); gy = wg(:, 2, 2, p)
+      else
+        call b9_factors(t(1, p), h(1), wx, gx)
+        call b9_factors(t(2, p), h(2), wy, gy)
+      end if
       do b = 1, 3
         I = cell(p) + int(s, int64) * (b - 1)
         do a = 1, 3
@@ -159,16 +190,18 @@ contains
         end do
       end do
     end do
-  end subroutine body_force_b9
+  end subroutine body_force_s9
 
   !> f_I −= Σ V_p σ_p ∇N_Ip (σ in Voigt order: xx, yy, zz, yz, xz, xy).
-  pure subroutine internal_force_b9(s, h, p0, p1, cell, t, vol, stress, f)
+  pure subroutine internal_force_s9(s, h, p0, p1, cell, t, gimp, wg, vol, stress, f)
     integer, intent(in) :: s                 !! nodes along x
     real(wp), intent(in) :: h(2)             !! 1/h per direction
     integer, intent(in) :: p0                !! first particle
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(2, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 2, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: vol(*)           !! particle volumes
     real(wp), intent(in) :: stress(6, *)     !! Cauchy stresses
     real(wp), intent(inout) :: f(2, *)       !! nodal forces (accumulated)
@@ -179,8 +212,13 @@ contains
     do p = p0, p1
       sx(1) = vol(p) * stress(1, p); sx(2) = vol(p) * stress(6, p)
       sy(1) = sx(2); sy(2) = vol(p) * stress(2, p)
-      call b9_factors(t(1, p), h(1), wx, gx)
-      call b9_factors(t(2, p), h(2), wy, gy)
+      if (gimp) then
+        wx = wg(:, 1, 1, p); gx = wg(:, 2, 1, p)
+        wy = wg(:, 1, 2, p); gy = wg(:, 2, 2, p)
+      else
+        call b9_factors(t(1, p), h(1), wx, gx)
+        call b9_factors(t(2, p), h(2), wy, gy)
+      end if
       do b = 1, 3
         I = cell(p) + int(s, int64) * (b - 1)
         do a = 1, 3
@@ -190,16 +228,18 @@ contains
         end do
       end do
     end do
-  end subroutine internal_force_b9
+  end subroutine internal_force_s9
 
   !> L_p = Σ v_I ⊗ ∇N_Ip, the 2×2 block of the 3×3 gradient, into L(:, :, 1..p1−p0+1).
-  pure subroutine velocity_gradient_b9(s, h, p0, p1, cell, t, v, L)
+  pure subroutine velocity_gradient_s9(s, h, p0, p1, cell, t, gimp, wg, v, L)
     integer, intent(in) :: s                 !! nodes along x
     real(wp), intent(in) :: h(2)             !! 1/h per direction
     integer, intent(in) :: p0                !! first particle
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(2, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 2, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: v(2, *)          !! nodal velocities
     real(wp), intent(inout) :: L(3, 3, *)    !! velocity gradients (2×2 block written)
     real(wp) :: wx(3), gx(3), wy(3), gy(3), lx(2), ly(2)
@@ -207,8 +247,13 @@ contains
     integer(int64) :: I
     !GCC$ novector
     do p = p0, p1
-      call b9_factors(t(1, p), h(1), wx, gx)
-      call b9_factors(t(2, p), h(2), wy, gy)
+      if (gimp) then
+        wx = wg(:, 1, 1, p); gx = wg(:, 2, 1, p)
+        wy = wg(:, 1, 2, p); gy = wg(:, 2, 2, p)
+      else
+        call b9_factors(t(1, p), h(1), wx, gx)
+        call b9_factors(t(2, p), h(2), wy, gy)
+      end if
       lx = 0.0_wp; ly = 0.0_wp
       do b = 1, 3
         I = cell(p) + int(s, int64) * (b - 1)
@@ -220,16 +265,18 @@ contains
       end do
       L(1:2, 1, p - p0 + 1) = lx; L(1:2, 2, p - p0 + 1) = ly
     end do
-  end subroutine velocity_gradient_b9
+  end subroutine velocity_gradient_s9
 
   !> u_p = Σ N_Ip q_I, or with `add` u_p += c Σ N_Ip q_I.
-  pure subroutine g2p_b9(s, h, p0, p1, cell, t, q, add, c, u)
+  pure subroutine g2p_s9(s, h, p0, p1, cell, t, gimp, wg, q, add, c, u)
     integer, intent(in) :: s                 !! nodes along x
     real(wp), intent(in) :: h(2)             !! 1/h per direction
     integer, intent(in) :: p0                !! first particle
     integer, intent(in) :: p1                !! last particle
     integer, intent(in) :: cell(*)           !! first node of each particle's stencil
     real(wp), intent(in) :: t(2, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 2, *)   !! uGIMP: values, slopes per direction
     real(wp), intent(in) :: q(2, *)          !! nodal vectors
     logical, intent(in) :: add               !! accumulate c Σ N q instead of overwriting
     real(wp), intent(in) :: c                !! scale (with `add`)
@@ -239,8 +286,13 @@ contains
     integer(int64) :: I
     !GCC$ novector
     do p = p0, p1
-      call b9_factors(t(1, p), h(1), wx, gx)
-      call b9_factors(t(2, p), h(2), wy, gy)
+      if (gimp) then
+        wx = wg(:, 1, 1, p); gx = wg(:, 2, 1, p)
+        wy = wg(:, 1, 2, p); gy = wg(:, 2, 2, p)
+      else
+        call b9_factors(t(1, p), h(1), wx, gx)
+        call b9_factors(t(2, p), h(2), wy, gy)
+      end if
       sm = 0.0_wp
       do b = 1, 3
         I = cell(p) + int(s, int64) * (b - 1)
@@ -255,6 +307,6 @@ contains
         u(:, p) = sm
       end if
     end do
-  end subroutine g2p_b9
+  end subroutine g2p_s9
 
-end module empm_transfer_b9
+end module empm_transfer_s9
