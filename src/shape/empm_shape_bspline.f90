@@ -38,11 +38,10 @@ module empm_shape_bspline
   use empm_kinds, only: wp
   use empm_grid, only: empm_grid_t
   use empm_particles, only: empm_particles_t
-  use empm_error, only: empm_error_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
-                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
-                        BASIS_LISTS, BASIS_B9, BASIS_B27
+                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, BASIS_LISTS, BASIS_B9, &
+                        BASIS_B27
   use empm_shape_linear, only: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, &
                                shape_batch_fits, shape_keep_first_failure, shape_tp_store, &
                                shape_stencil_batch
@@ -168,16 +167,11 @@ contains
     integer, intent(out) :: ibad                    !! first failing particle, 0 if none
     integer, intent(out) :: info                    !! SHAPE_OK or the failing particle's code
     integer :: p, pinfo
-    type(empm_error_t) :: err
     call shape_batch_fits(pts%np, basis, ibad, info, compact=self%layout(grid))
     if (info /= SHAPE_OK) return
     if (basis%layout == BASIS_B9 .or. basis%layout == BASIS_B27) then
+      ! Done, unless a stencil reaches beyond the grid: then node lists, evaluated below.
       if (shape_stencil_batch(grid, pts, .false., 0.0_wp, basis, ibad, info)) return
-      ! A stencil reaches beyond the grid: node lists from now on (one allocation per run).
-      call basis%alloc(grid%ndim, basis%maxn, basis%np, BASIS_LISTS, err)
-      if (err%code /= 0) then
-        ibad = 1; info = SHAPE_BAD_LAYOUT; return
-      end if
     end if
     if (.not. self%clamped .and. grid%ndim >= 2 .and. &
         basis%maxn >= (self%order + 1)**grid%ndim .and. size(basis%dN, 1) >= grid%ndim) then

@@ -8,6 +8,7 @@
 !> factory and is expected to agree with it.
 module empm_shape_linear
   use empm_kinds, only: wp
+  use empm_error, only: empm_error_t
   use empm_grid, only: empm_grid_t
   use empm_particles, only: empm_particles_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
@@ -448,11 +449,12 @@ contains
   !> - uGIMP (`ugimp_1d`): nearest node c = nint(s), first node c − 1, t = s − c, and the
   !>   half-length el = lp/h (at most `el_max`, then min(el, ½), as `ugimp_1d` takes it); the
   !>   1D factors are computed here and stored.
-  !> t is exact either way. False, with nothing reported, when some particle inside the grid
-  !> cannot be held (a stencil node beyond the grid; uGIMP: el not in (0, el_max]): the caller
-  !> turns to node lists, which give that particle's own result or failure. Otherwise true,
+  !> t is exact either way. When some particle inside the grid cannot be held (a stencil node
+  !> beyond the grid; uGIMP: el not in (0, el_max]), the storage is turned into node lists
+  !> (once for the run: one allocation) and the result is false, nothing reported: the caller
+  !> evaluates the lists, which give that particle's own result or failure. Otherwise true,
   !> `ibad` the first particle outside the closed grid box (the test of grid%inside, which a NaN
-  !> fails too) or 0.
+  !> fails too) or 0; or `ibad` = 1 and SHAPE_BAD_LAYOUT when the lists could not be allocated.
   logical function shape_stencil_batch(grid, pts, gimp, el_max, basis, ibad, info) result(held)
     type(empm_grid_t), intent(in) :: grid           !! background grid (2D or 3D)
     type(empm_particles_t), intent(in) :: pts       !! particles
@@ -464,6 +466,7 @@ contains
     real(wp) :: o(3), e(3), ih(3), s, t(3), el, wg(3, 2, 3)
     integer :: nc, c, p0, p1, p, d, nd, i, id, id0, lim(3), str(3), iout, k0, k1
     logical :: inside, fits
+    type(empm_error_t) :: err
     nd = grid%ndim
     o = 0.0_wp; e = 0.0_wp; ih = 1.0_wp; lim = 0; str = 0; t = 0.0_wp; el = 0.0_wp; wg = 0.0_wp
     do d = 1, nd
@@ -522,6 +525,13 @@ contains
     !$omp end parallel do
     held = iout == huge(1)
     info = SHAPE_OK
+    if (.not. held) then
+      call basis%alloc(nd, basis%maxn, basis%np, BASIS_LISTS, err)
+      if (err%code /= 0) then
+        held = .true.; ibad = 1; info = SHAPE_BAD_LAYOUT
+      end if
+      return
+    end if
     if (ibad == huge(1)) then
       ibad = 0
     else

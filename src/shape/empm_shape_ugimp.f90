@@ -31,10 +31,9 @@ module empm_shape_ugimp
   use empm_grid, only: empm_grid_t
   use empm_particles, only: empm_particles_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
-  use empm_error, only: empm_error_t
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
-                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
-                        BASIS_LISTS, BASIS_G9, BASIS_G27
+                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, BASIS_LISTS, BASIS_G9, &
+                        BASIS_G27
   use empm_shape_linear, only: SHAPE_TP_MAXM, SHAPE_CLIP_TOL, shape_tp_init, shape_tp_assemble, &
                                shape_batch_fits, shape_keep_first_failure, shape_tp_store, &
                                shape_stencil_batch
@@ -127,17 +126,12 @@ contains
     integer :: p, pinfo
     real(wp) :: w(3, 3), g(3, 3)
     integer :: m(3), base(3), d
-    type(empm_error_t) :: err
     call shape_batch_fits(pts%np, basis, ibad, info, compact=self%layout(grid))
     if (info /= SHAPE_OK) return
     if (basis%layout == BASIS_G9 .or. basis%layout == BASIS_G27) then
+      ! Done, unless a particle cannot be held: then node lists, evaluated below.
       if (shape_stencil_batch(grid, pts, .true., 0.5_wp * (1.0_wp + LP_TOL), basis, ibad, info)) &
         return
-      ! A particle the stencil cannot hold: node lists from now on (one allocation per run).
-      call basis%alloc(grid%ndim, basis%maxn, basis%np, BASIS_LISTS, err)
-      if (err%code /= 0) then
-        ibad = 1; info = SHAPE_BAD_LAYOUT; return
-      end if
     end if
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
