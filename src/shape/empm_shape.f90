@@ -20,7 +20,7 @@ module empm_shape
             BASIS_G27, basis_q4_weights, basis_stencil_factors
   public :: SHAPE_OK, SHAPE_OUTSIDE_GRID, SHAPE_SUPPORT_CLIPPED, SHAPE_NOT_CONVERGED, &
             SHAPE_OUTSIDE_HULL, SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
-            shape_status_text
+            SHAPE_NO_MEMORY, shape_status_text
 
   integer, parameter :: SHAPE_OK = 0              !! evaluation succeeded
   integer, parameter :: SHAPE_OUTSIDE_GRID = 1    !! the point lies outside the grid box
@@ -30,6 +30,7 @@ module empm_shape
   integer, parameter :: SHAPE_SINGULAR = 5        !! singular or ill-conditioned system
   integer, parameter :: SHAPE_TOO_MANY_NODES = 6  !! support larger than the storage provided
   integer, parameter :: SHAPE_BAD_LAYOUT = 7      !! basis storage layout this family cannot fill
+  integer, parameter :: SHAPE_NO_MEMORY = 8       !! no memory to turn a compact basis into lists
 
   integer, parameter :: BASIS_LISTS = 0 !! layout: node lists with values and gradients (any family)
   integer, parameter :: BASIS_Q4 = 1    !! layout: bilinear on a 2D grid, the cell and two local
@@ -37,19 +38,19 @@ module empm_shape
   integer, parameter :: BASIS_B27 = 3   !! layout: BASIS_B9 on a 3D grid (3 × 3 × 3 stencil, three
                                         !! local coordinates per particle)
   integer, parameter :: BASIS_G9 = 4    !! layout: uGIMP on a 2D grid, the first node of the 3 × 3
-                                        !! stencil, two local coordinates and two half-lengths
+                                        !! stencil and the stored 1D factors per particle
   integer, parameter :: BASIS_G27 = 5   !! layout: BASIS_G9 on a 3D grid
   integer, parameter :: BASIS_B9 = 2    !! layout: uniform quadratic B-splines on a 2D grid, the
                                         !! first node of the 3 × 3 stencil and two local
                                         !! coordinates per particle (values recomputed when used)
 
-  !> Shape-function values and gradients for every particle, in one of three layouts.
+  !> Shape-function values and gradients for every particle, in one of six layouts.
   !>
   !> `BASIS_LISTS` (any family): per particle the number of supporting nodes, their indices,
-  !> values and gradients, contiguous per particle. Two compact layouts, chosen by a family
+  !> values and gradients, contiguous per particle. Compact layouts, chosen by a family
   !> through [[empm_shape_t(type):layout]], keep per particle only a node `cell` and local
-  !> coordinates `t`, and every transfer recomputes the values and gradients from them (20 B
-  !> per particle, read four times a step, instead of 116 B or 252 B):
+  !> coordinates `t` (uGIMP: 1D factors), and every transfer forms the values and gradients
+  !> from them (20–148 B per particle, read four times a step, instead of 116–972 B):
   !> - `BASIS_Q4` (linear shapes on a 2D grid): `cell` the lowest node of the particle's cell,
   !>   t ∈ [0, 1]²; the four nodes cell, cell + 1, cell + stride, cell + stride + 1 and the
   !>   bilinear values of [[basis_q4_weights]];
@@ -70,7 +71,8 @@ module empm_shape
   !> Either way, [[basis_get]] gives one particle's nodes, values and gradients, the same bits
   !> as the transfers use.
   type :: empm_basis_t
-    integer :: layout = BASIS_LISTS         !! BASIS_LISTS, BASIS_Q4 or BASIS_B9
+    integer :: layout = BASIS_LISTS         !! BASIS_LISTS or a compact layout (BASIS_Q4, BASIS_B9,
+                                            !! BASIS_B27, BASIS_G9, BASIS_G27)
     integer :: ndim = 0                     !! spatial dimension
     integer :: maxn = 0                     !! capacity: nodes per particle
     integer :: np = 0                       !! number of particles
@@ -392,6 +394,8 @@ contains
     case (SHAPE_SINGULAR);        s = 'singular or ill-conditioned system'
     case (SHAPE_TOO_MANY_NODES);  s = 'support larger than the storage provided'
     case (SHAPE_BAD_LAYOUT);      s = 'basis storage layout this shape family cannot fill'
+    case (SHAPE_NO_MEMORY);       s = 'not enough memory to turn the compact shape-function '// &
+                                      'storage into node lists'
     case default;                 s = 'unknown shape-function status'
     end select
   end function shape_status_text

@@ -13,7 +13,7 @@ module empm_shape_linear
   use empm_particles, only: empm_particles_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
-                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
+                        SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, SHAPE_NO_MEMORY, &
                         BASIS_LISTS, BASIS_Q4, BASIS_G9, BASIS_G27, basis_q4_weights, &
                         basis_stencil_factors
   implicit none
@@ -405,7 +405,7 @@ contains
 
   !> Check that `basis` has storage for `np` particles before a batch (the per-particle
   !> capacity and dimension are checked by [[shape_tp_assemble]]) in a layout the caller
-  !> fills: node lists always, a compact layout (BASIS_Q4, BASIS_B9) only when it is
+  !> fills: node lists always, a compact layout (BASIS_Q4, BASIS_B9, ...) only when it is
   !> `compact`. On failure `ibad` is the first particle without storage and
   !> `info = SHAPE_TOO_MANY_NODES`, or `ibad = 1` and `info = SHAPE_BAD_LAYOUT`.
   pure subroutine shape_batch_fits(np, basis, ibad, info, compact)
@@ -454,7 +454,8 @@ contains
   !> (once for the run: one allocation) and the result is false, nothing reported: the caller
   !> evaluates the lists, which give that particle's own result or failure. Otherwise true,
   !> `ibad` the first particle outside the closed grid box (the test of grid%inside, which a NaN
-  !> fails too) or 0; or `ibad` = 1 and SHAPE_BAD_LAYOUT when the lists could not be allocated.
+  !> fails too) or 0; or `ibad` = 1 and SHAPE_NO_MEMORY when the lists could not be allocated
+  !> (the storage is then empty).
   logical function shape_stencil_batch(grid, pts, gimp, el_max, basis, ibad, info) result(held)
     type(empm_grid_t), intent(in) :: grid           !! background grid (2D or 3D)
     type(empm_particles_t), intent(in) :: pts       !! particles
@@ -462,7 +463,8 @@ contains
     real(wp), intent(in) :: el_max                  !! uGIMP: largest half-length in cells
     type(empm_basis_t), intent(inout) :: basis      !! compact stencil storage
     integer, intent(out) :: ibad                    !! first particle outside the grid, or 0
-    integer, intent(out) :: info                    !! SHAPE_OK or SHAPE_OUTSIDE_GRID
+    integer, intent(out) :: info                    !! SHAPE_OK, SHAPE_OUTSIDE_GRID or
+                                                    !! SHAPE_NO_MEMORY
     real(wp) :: o(3), e(3), ih(3), s, t(3), el, wg(3, 2, 3)
     integer :: nc, c, p0, p1, p, d, nd, i, id, id0, lim(3), str(3), iout, k0, k1
     logical :: inside, fits
@@ -528,7 +530,7 @@ contains
     if (.not. held) then
       call basis%alloc(nd, basis%maxn, basis%np, BASIS_LISTS, err)
       if (err%code /= 0) then
-        held = .true.; ibad = 1; info = SHAPE_BAD_LAYOUT
+        held = .true.; ibad = 1; info = SHAPE_NO_MEMORY
       end if
       return
     end if

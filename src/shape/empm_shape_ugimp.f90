@@ -21,9 +21,9 @@
 !> otherwise 3.
 !>
 !> **Compact layout.** On 2D and 3D grids the family fills `BASIS_G9` / `BASIS_G27` (per
-!> particle the first node of its 3^ndim stencil, ndim local coordinates and ndim half-lengths
-!> in cells; [[empm_basis_t]]), whose transfers recompute the values ([[empm_transfer_s9]],
-!> [[empm_transfer_s27]]). A particle the layout cannot hold (a stencil node beyond the grid,
+!> particle the first node of its 3^ndim stencil and the 3 values and slopes per direction,
+!> computed once a step; [[empm_basis_t]]), whose transfers form their products
+!> ([[empm_transfer_s9]], [[empm_transfer_s27]]). A particle the layout cannot hold (a stencil node beyond the grid,
 !> or lp outside (0, h/2]) turns the storage into node lists, once, with their results and
 !> failures.
 module empm_shape_ugimp
@@ -173,7 +173,7 @@ contains
   end subroutine ugimp_eval_batch
 
   !> Basis layout: BASIS_G9 on a 2D grid, BASIS_G27 on a 3D one (the first node of the 3^ndim
-  !> stencil, ndim local coordinates and half-lengths per particle), node lists otherwise.
+  !> stencil and the stored 1D factors per particle), node lists otherwise.
   pure integer function ugimp_layout(self, grid)
     class(empm_shape_ugimp_t), intent(in) :: self !! shape family
     type(empm_grid_t), intent(in) :: grid         !! background grid

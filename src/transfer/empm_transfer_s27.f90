@@ -1,12 +1,12 @@
 !> Transfer kernels on the compact 3 × 3 × 3 stencils of a 3D grid (`BASIS_B27` and
 !> `BASIS_G27` of [[empm_basis_t]]): per particle the first node `id` of its stencil and the
-!> local coordinates (t1, t2, t3), with uGIMP the half-lengths in cells too; the nodes are
+!> local coordinates (t1, t2, t3) — for uGIMP the stored 1D factors (`wg`); the nodes are
 !> id + a + s·b + s2·c (a, b, c = 0, 1, 2; s = nodes along x, s2 = nodes per x-y plane) and the
-!> values and gradients are recomputed here: 3 + 3 + 3 one-dimensional factors (quadratic
-!> B-spline or uGIMP, as in [[empm_transfer_s9]]), then their products.
+!> values and gradients are formed here: 3 + 3 + 3 one-dimensional factors (B-splines:
+!> recomputed; uGIMP: read, as in [[empm_transfer_s9]]), then their products.
 !>
 !> Why: the node lists of a 3D basis with 27 nodes hold 972 B per particle, written by the shape
-!> phase and read by four passes a step; the compact layouts hold 28 B (B-splines) or 52 B
+!> phase and read by four passes a step; the compact layouts hold 28 B (B-splines) or 148 B
 !> (uGIMP). The products are those of the lists (`shape_tp_store`), and every kernel does the
 !> arithmetic of its node-list counterpart in [[empm_transfer_3d]] / [[empm_transfer]] in the
 !> same order; a zero-valued stencil node adds ±0, so the results are the lists', the sign of

@@ -1,12 +1,11 @@
 !> Transfer kernels on the compact 3 × 3 stencils of a 2D grid (`BASIS_B9` and `BASIS_G9` of
 !> [[empm_basis_t]]): per particle the first node `id` of its stencil and the local coordinates
-!> (t1, t2), with uGIMP the half-lengths in cells (el1, el2) too; the nodes are id + a + s·b
-!> (a, b = 0, 1, 2; s = nodes along x) and the values and gradients are recomputed here: 3 + 3
-!> one-dimensional factors, quadratic B-spline ([[basis_stencil_factors]]: `b9_factors`) or
-!> uGIMP (`g9_factors`), then their products.
+!> (t1, t2) — for uGIMP instead the 3 + 3 one-dimensional factors the shape phase stored (`wg`);
+!> the nodes are id + a + s·b (a, b = 0, 1, 2; s = nodes along x). The B-spline factors are
+!> recomputed here (`b9_factors` of [[basis_stencil_factors]]), then their products formed.
 !>
 !> Why: the node lists of a 2D basis with 9 nodes hold 252 B per particle, written by the shape
-!> phase and read by four passes a step; the compact layouts hold 20 B (B-splines) or 36 B
+!> phase and read by four passes a step; the compact layouts hold 20 B (B-splines) or 100 B
 !> (uGIMP), and the fixed 3 × 3 loops need no node count or index loads. The factors are
 !> included from src/shape/empm_stencil_weights.inc (one text with [[basis_get]], compiled into
 !> this file so that it is inlined); every kernel does the same arithmetic in the same order as
