@@ -35,14 +35,14 @@ module empm_shape
   integer, parameter :: BASIS_LISTS = 0 !! layout: node lists with values and gradients (any family)
   integer, parameter :: BASIS_Q4 = 1    !! layout: bilinear on a 2D grid, the cell and two local
                                         !! coordinates per particle (values recomputed when used)
+  integer, parameter :: BASIS_B9 = 2    !! layout: uniform quadratic B-splines on a 2D grid, the
+                                        !! first node of the 3 × 3 stencil and two local
+                                        !! coordinates per particle (values recomputed when used)
   integer, parameter :: BASIS_B27 = 3   !! layout: BASIS_B9 on a 3D grid (3 × 3 × 3 stencil, three
                                         !! local coordinates per particle)
   integer, parameter :: BASIS_G9 = 4    !! layout: uGIMP on a 2D grid, the first node of the 3 × 3
                                         !! stencil and the stored 1D factors per particle
   integer, parameter :: BASIS_G27 = 5   !! layout: BASIS_G9 on a 3D grid
-  integer, parameter :: BASIS_B9 = 2    !! layout: uniform quadratic B-splines on a 2D grid, the
-                                        !! first node of the 3 × 3 stencil and two local
-                                        !! coordinates per particle (values recomputed when used)
 
   !> Shape-function values and gradients for every particle, in one of six layouts.
   !>
