@@ -27,7 +27,8 @@
 !> arrays must be contiguous.
 module empm_transfer
   use empm_kinds, only: wp
-  use empm_shape, only: empm_basis_t, BASIS_Q4, BASIS_B9, BASIS_B27, BASIS_G9, BASIS_G27
+  use empm_shape, only: empm_basis_t, BASIS_LISTS, BASIS_Q4, BASIS_B9, BASIS_B27, BASIS_G9, &
+                        BASIS_G27
   use empm_nodes, only: empm_nodes_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_transfer_2d, only: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, &
@@ -112,33 +113,23 @@ contains
   subroutine p2g_work_set_ranges(self, basis)
     class(empm_p2g_work_t), intent(inout) :: self !! workspace
     type(empm_basis_t), intent(in) :: basis       !! shape functions at the particles
-    integer :: c, p0, p1, p, k, lo, hi, last(0:1)
+    integer :: c, p0, p1, p, k, lo, hi, last(0:1), span
     if (self%nt <= 1) return
+    ! A compact layout's nodes run from `cell` to `cell + span` (the last node of its stencil).
+    span = 0
+    if (basis%layout == BASIS_Q4) span = basis%stride + 1
+    if (is_s9(basis)) span = 2 * basis%stride + 2
+    if (is_s27(basis)) span = 2 * basis%stride2 + 2 * basis%stride + 2
     ! Sub-chunk by sub-chunk, each one's particles shared by all threads (a loop over the
     ! sub-chunks would leave threads idle when there are few of them).
     do c = 1, 2 * self%nt
       call empm_chunk_bounds(basis%np, 2 * self%nt, c - 1, p0, p1)
       lo = huge(1); hi = 0
-      if (basis%layout == BASIS_Q4) then
+      if (basis%layout /= BASIS_LISTS) then
         !$omp parallel do num_threads(self%nt) schedule(static) default(none) &
-        !$omp   shared(basis, p0, p1) reduction(min: lo) reduction(max: hi)
+        !$omp   shared(basis, p0, p1, span) reduction(min: lo) reduction(max: hi)
         do p = p0, p1
-          lo = min(lo, basis%cell(p)); hi = max(hi, basis%cell(p) + basis%stride + 1)
-        end do
-        !$omp end parallel do
-      else if (is_s9(basis)) then
-        !$omp parallel do num_threads(self%nt) schedule(static) default(none) &
-        !$omp   shared(basis, p0, p1) reduction(min: lo) reduction(max: hi)
-        do p = p0, p1
-          lo = min(lo, basis%cell(p)); hi = max(hi, basis%cell(p) + 2 * basis%stride + 2)
-        end do
-        !$omp end parallel do
-      else if (is_s27(basis)) then
-        !$omp parallel do num_threads(self%nt) schedule(static) default(none) &
-        !$omp   shared(basis, p0, p1) reduction(min: lo) reduction(max: hi)
-        do p = p0, p1
-          lo = min(lo, basis%cell(p))
-          hi = max(hi, basis%cell(p) + 2 * basis%stride2 + 2 * basis%stride + 2)
+          lo = min(lo, basis%cell(p)); hi = max(hi, basis%cell(p) + span)
         end do
         !$omp end parallel do
       else
