@@ -14,8 +14,8 @@ module empm_integrator
                         STEP_MATERIAL_FAILED
   use empm_transfer, only: p2g_mass, p2g_mass_momentum, p2g_weighted, p2g_internal_force, &
                            p2g_body_force, &
-                           nodal_divide_by_mass, g2p_value, g2p_block, &
-                           velocity_gradient, empm_p2g_work_t
+                           nodal_divide_by_mass, g2p_value, &
+                           velocity_gradient, gradient_g2p_block, axpy_flat, empm_p2g_work_t
   use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_STRESS, &
                         PHASE_G2P
   use empm_material, only: empm_material_ctx_t
@@ -349,12 +349,15 @@ contains
     real(wp), intent(in) :: c                      !! scale
     real(wp), intent(in), contiguous :: a(:,:)     !! particle vectors (ndim, >= np)
     real(wp), intent(inout), contiguous :: y(:,:)  !! particle vectors (ndim, >= np)
-    integer :: p
+    integer :: nc, ic, p0, p1, d
     if (c == 0.0_wp) return
-    !$omp parallel do default(none) shared(np, c, a, y) schedule(static) &
-    !$omp   if(np >= EMPM_OMP_MIN_PARTICLES)
-    do p = 1, np
-      y(:, p) = y(:, p) + c * a(:, p)
+    d = size(y, 1)
+    nc = empm_chunks(np)
+    !$omp parallel do default(none) schedule(static, 1) shared(np, nc, d, c, a, y) &
+    !$omp   private(p0, p1) if(nc > 1)
+    do ic = 0, nc - 1
+      call empm_chunk_bounds(np, nc, ic, p0, p1)
+      if (p1 >= p0) call axpy_flat(d * (p1 - p0 + 1), c, a(:, p0:p1), y(:, p0:p1))
     end do
     !$omp end parallel do
   end subroutine particle_axpy
@@ -618,27 +621,37 @@ contains
   !> (docs/integrators.md, "Why the drift is trapezoidal"): keep L⁰ = Σ v_I ⊗ ∇N_Ip, add the
   !> correction left by the last step to x, keep the resulting start positions in `pts%dx`
   !> ([[drift_end]] forms the next correction from them) and move the particles by
-  !> Δt G2P(v)_p. `v` is the grid velocity field whose interpolation moves the particles. One
-  !> pass, block by block, so that each block's basis is read from cache the second time.
-  subroutine drift_begin(self, model, v, dt)
+  !> Δt G2P(v)_p. `v` is the grid velocity field whose interpolation moves the particles. With
+  !> `cx` and `cv`, the particle updates x += cx a and (after the move) v += cv a of the scheme
+  !> are made in the same pass, as [[particle_axpy]] would make them (skipped when 0). One pass,
+  !> block by block: each block's particle data is read once, its basis and nodes once.
+  subroutine drift_begin(self, model, v, dt, cx, cv)
     class(empm_integrator_t), intent(inout) :: self  !! integrator (l0)
     type(empm_model_t), intent(inout) :: model       !! simulation state
     real(wp), intent(in), contiguous :: v(:,:)       !! v_I (ndim, nnode)
     real(wp), intent(in) :: dt                       !! time step [s]
-    real(wp) :: Lb(3, 3, STRESS_BLOCK)
+    real(wp), intent(in), optional :: cx             !! x += cx a before the drift (default 0)
+    real(wp), intent(in), optional :: cv             !! v += cv a (default 0)
+    real(wp) :: Lb(3, 3, STRESS_BLOCK), ax, av
     integer :: np, nc, c, a, b, q0, q1, d
     np = model%pts%np; d = model%grid%ndim
+    ax = 0.0_wp; av = 0.0_wp
+    if (present(cx)) ax = cx
+    if (present(cv)) av = cv
     nc = empm_chunks(np)
-    !$omp parallel do default(none) schedule(static, 1) shared(model, self, v, dt, np, nc, d) &
-    !$omp& private(a, b, q0, q1, Lb) if(nc > 1)
+    !$omp parallel do default(none) schedule(static, 1) &
+    !$omp& shared(model, self, v, dt, np, nc, d, ax, av) private(a, b, q0, q1, Lb) if(nc > 1)
     do c = 0, nc - 1
       call empm_chunk_bounds(np, nc, c, a, b)
       do q0 = a, b, STRESS_BLOCK
         q1 = min(b, q0 + STRESS_BLOCK - 1)
-        call velocity_gradient(model%basis, v, q0, q1, Lb)
-        call keep_gradients(d, q0, q1, Lb, self%l0)
+        if (ax /= 0.0_wp) call axpy_flat(d * (q1 - q0 + 1), ax, model%pts%a(:, q0:q1), &
+                                          model%pts%x(:, q0:q1))
         call shift_keep(q0, q1, model%pts%x, model%pts%dx)
-        call g2p_block(model%basis, dt, v, q0, q1, model%pts%x)
+        call gradient_g2p_block(model%basis, v, q0, q1, Lb, dt, model%pts%x)
+        call keep_gradients(d, q0, q1, Lb, self%l0)
+        if (av /= 0.0_wp) call axpy_flat(d * (q1 - q0 + 1), av, model%pts%a(:, q0:q1), &
+                                          model%pts%v(:, q0:q1))
       end do
     end do
     !$omp end parallel do
@@ -859,13 +872,14 @@ contains
         g0 = a
         do q0 = a, b, STRESS_BLOCK
           q1 = min(b, q0 + STRESS_BLOCK - 1)
-          call velocity_gradient(model%basis, vel, q0, q1, Lb)
           if (tz) then
-            ! The trapezoidal drift: its gradient, and its position correction while the
-            ! block's basis is in cache, dx = ½(dx − x) + ½Δt G2P(u) ([[drift_end]]).
-            call trapezoid_gradient(dt, lprev(:, :, q0:q1), Lb)
+            ! The trapezoidal drift: its gradient, and its position correction from the same
+            ! pass over the block's basis, dx = ½(dx − x) + ½Δt G2P(u) ([[drift_end]]).
             call half_back(q0, q1, model%pts%x, model%pts%dx)
-            call g2p_block(model%basis, 0.5_wp * dt, vel, q0, q1, model%pts%dx)
+            call gradient_g2p_block(model%basis, vel, q0, q1, Lb, 0.5_wp * dt, model%pts%dx)
+            call trapezoid_gradient(dt, lprev(:, :, q0:q1), Lb)
+          else
+            call velocity_gradient(model%basis, vel, q0, q1, Lb)
           end if
           if (sm) then
             do p = q0, q1

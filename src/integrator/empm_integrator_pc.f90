@@ -20,7 +20,7 @@ module empm_integrator_pc
   use empm_params, only: empm_param_t, empm_param, PARAM_REAL
   use empm_namelist, only: empm_group_t
   use empm_integrator, only: empm_integrator_t, map_velocity, update_stress, initial_acceleration, &
-                             drift_prepare, drift_begin, drift_end, particle_axpy
+                             drift_prepare, drift_begin, drift_end
   use empm_model, only: empm_model_t, empm_step_status_t, STEP_OK
   use empm_transfer, only: g2p_add_scaled, g2p_value, nodal_divide_by_mass
   use empm_timer, only: PHASE_P2G, PHASE_GRID, PHASE_G2P, PHASE_STRESS
@@ -140,9 +140,8 @@ contains
         ! the basis of x^n), trapezoidal over the bases of x^n and x^{n+1} (the projection
         ! particles → grid → particles moves with the particles; docs/integrators.md), then
         ! the stress with the drift's deformation gradient.
-        call particle_axpy(pts%np, (g - 0.5_wp) * dt * dt, pts%a, pts%x)
-        call drift_begin(self, model, nodes%vel, dt)
-        call particle_axpy(pts%np, (1.0_wp - g) * dt, pts%a, pts%v)
+        ! One pass: x += (γ − ½)Δt² a_p, the drift's first half, v += (1 − γ)Δt a_p.
+        call drift_begin(self, model, nodes%vel, dt, (g - 0.5_wp) * dt * dt, (1.0_wp - g) * dt)
         call tm%lap(PHASE_G2P)
         call drift_end(self, model, dt, stat)
         if (stat%code /= STEP_OK) return
@@ -151,8 +150,7 @@ contains
         call tm%lap(PHASE_P2G)
         call nodal_divide_by_mass(nodes, nodes%force, nodes%acc)
         call tm%lap(PHASE_GRID)
-        call g2p_value(basis, nodes%acc, pts%a)
-        call particle_axpy(pts%np, g * dt, pts%a, pts%v)
+        call g2p_value(basis, nodes%acc, pts%a, g * dt, pts%v) ! and v += γΔt a_p
       end if
       call tm%lap(PHASE_G2P)
     end associate

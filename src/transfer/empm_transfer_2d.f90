@@ -13,7 +13,8 @@ module empm_transfer_2d
   use empm_kinds, only: wp
   implicit none
   private
-  public :: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, g2p_2d
+  public :: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, g2p_2d, &
+            gradient_g2p_2d
 
 contains
 
@@ -121,5 +122,36 @@ contains
       end if
     end do
   end subroutine g2p_2d
+
+  !> The two of [[velocity_gradient_2d]] and [[g2p_2d]] (with `add`) on the same nodal field in
+  !> one pass, for particles p0..p1: L_p = Σ v_I ⊗ ∇N_Ip into L(:, :, 1..p1−p0+1) and
+  !> u_p += c Σ N_Ip v_I, each sum in its own kernel's order (the same bits); the node indices
+  !> and velocities are read once.
+  pure subroutine gradient_g2p_2d(mx, p0, p1, nn, node, N, dN, v, L, c, u)
+    integer, intent(in) :: mx                !! basis capacity (nodes per particle)
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: N(mx, *)         !! shape-function values
+    real(wp), intent(in) :: dN(2, mx, *)     !! shape-function gradients
+    real(wp), intent(in) :: v(2, *)          !! nodal velocities
+    real(wp), intent(inout) :: L(3, 3, *)    !! velocity gradients (2×2 block written)
+    real(wp), intent(in) :: c                !! scale of the interpolated velocity
+    real(wp), intent(inout) :: u(2, *)       !! particle vectors (accumulated)
+    real(wp) :: gx(2), gy(2), s(2)
+    integer :: p, k, I
+    do p = p0, p1
+      gx = 0.0_wp; gy = 0.0_wp; s = 0.0_wp
+      do k = 1, nn(p)
+        I = node(k, p)
+        gx = gx + v(:, I) * dN(1, k, p)
+        gy = gy + v(:, I) * dN(2, k, p)
+        s = s + N(k, p) * v(:, I)
+      end do
+      L(1:2, 1, p - p0 + 1) = gx; L(1:2, 2, p - p0 + 1) = gy
+      u(:, p) = u(:, p) + c * s
+    end do
+  end subroutine gradient_g2p_2d
 
 end module empm_transfer_2d

@@ -11,7 +11,8 @@ module empm_transfer_3d
   use empm_kinds, only: wp
   implicit none
   private
-  public :: internal_force_3d, velocity_gradient_3d, g2p_3d
+  public :: internal_force_3d, velocity_gradient_3d, g2p_3d, &
+            gradient_g2p_3d
 
 contains
 
@@ -95,5 +96,37 @@ contains
       end if
     end do
   end subroutine g2p_3d
+
+  !> The two of [[velocity_gradient_3d]] and [[g2p_3d]] (with `add`) on the same nodal field in
+  !> one pass, for particles p0..p1: L_p = Σ v_I ⊗ ∇N_Ip into L(:, :, 1..p1−p0+1) and
+  !> u_p += c Σ N_Ip v_I, each sum in its own kernel's order (the same bits); the node indices
+  !> and velocities are read once.
+  pure subroutine gradient_g2p_3d(mx, p0, p1, nn, node, N, dN, v, L, c, u)
+    integer, intent(in) :: mx                !! basis capacity (nodes per particle)
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: N(mx, *)         !! shape-function values
+    real(wp), intent(in) :: dN(3, mx, *)     !! shape-function gradients
+    real(wp), intent(in) :: v(3, *)          !! nodal velocities
+    real(wp), intent(inout) :: L(3, 3, *)    !! velocity gradients (written)
+    real(wp), intent(in) :: c                !! scale of the interpolated velocity
+    real(wp), intent(inout) :: u(3, *)       !! particle vectors (accumulated)
+    real(wp) :: gx(3), gy(3), gz(3), s(3)
+    integer :: p, k, I
+    do p = p0, p1
+      gx = 0.0_wp; gy = 0.0_wp; gz = 0.0_wp; s = 0.0_wp
+      do k = 1, nn(p)
+        I = node(k, p)
+        gx = gx + v(:, I) * dN(1, k, p)
+        gy = gy + v(:, I) * dN(2, k, p)
+        gz = gz + v(:, I) * dN(3, k, p)
+        s = s + N(k, p) * v(:, I)
+      end do
+      L(:, 1, p - p0 + 1) = gx; L(:, 2, p - p0 + 1) = gy; L(:, 3, p - p0 + 1) = gz
+      u(:, p) = u(:, p) + c * s
+    end do
+  end subroutine gradient_g2p_3d
 
 end module empm_transfer_3d

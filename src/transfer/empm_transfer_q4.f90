@@ -17,7 +17,7 @@ module empm_transfer_q4
   implicit none
   private
   public :: mass_q4, weighted_q4, mass_momentum_q4, body_force_q4, internal_force_q4, &
-            velocity_gradient_q4, g2p_q4
+            velocity_gradient_q4, g2p_q4, gradient_g2p_q4
 
 contains
 
@@ -216,5 +216,37 @@ contains
       end if
     end do
   end subroutine g2p_q4
+
+  !> The two of [[velocity_gradient_q4]] and [[g2p_q4]] (with `add`) on the same nodal field in
+  !> one pass: L_p = Σ v_I ⊗ ∇N_Ip into L(:, :, 1..p1−p0+1) and u_p += c Σ N_Ip v_I, each sum in
+  !> its own kernel's order (the same bits); the nodes are read and the weights formed once.
+  pure subroutine gradient_g2p_q4(s, h, p0, p1, cell, t, v, L, c, u)
+    integer, intent(in) :: s                 !! nodes along x
+    real(wp), intent(in) :: h(2)             !! 1/h per direction
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: cell(*)           !! lowest node of each particle's cell
+    real(wp), intent(in) :: t(2, *)          !! local coordinates
+    real(wp), intent(in) :: v(2, *)          !! nodal velocities
+    real(wp), intent(inout) :: L(3, 3, *)    !! velocity gradients (2×2 block written)
+    real(wp), intent(in) :: c                !! scale of the interpolated velocity
+    real(wp), intent(inout) :: u(2, *)       !! particle vectors (accumulated)
+    real(wp) :: N(4), dN(2, 4), gx(2), gy(2), sm(2)
+    integer :: p
+    integer(int64) :: I, J ! 64-bit: the neighbours' addresses are offsets of I's
+    !GCC$ novector
+    do p = p0, p1
+      call q4_values(t(1, p), t(2, p), N)
+      call q4_gradients(t(1, p), t(2, p), h(1), h(2), -h(1), -h(2), dN)
+      I = cell(p); J = I + s
+      gx = 0.0_wp; gy = 0.0_wp; sm = 0.0_wp
+      gx = gx + v(:, I) * dN(1, 1);     gy = gy + v(:, I) * dN(2, 1);     sm = sm + N(1) * v(:, I)
+      gx = gx + v(:, I + 1) * dN(1, 2); gy = gy + v(:, I + 1) * dN(2, 2); sm = sm + N(2) * v(:, I + 1)
+      gx = gx + v(:, J) * dN(1, 3);     gy = gy + v(:, J) * dN(2, 3);     sm = sm + N(3) * v(:, J)
+      gx = gx + v(:, J + 1) * dN(1, 4); gy = gy + v(:, J + 1) * dN(2, 4); sm = sm + N(4) * v(:, J + 1)
+      L(1:2, 1, p - p0 + 1) = gx; L(1:2, 2, p - p0 + 1) = gy
+      u(:, p) = u(:, p) + c * sm
+    end do
+  end subroutine gradient_g2p_q4
 
 end module empm_transfer_q4

@@ -19,7 +19,7 @@ module empm_transfer_s27
   implicit none
   private
   public :: mass_s27, weighted_s27, mass_momentum_s27, body_force_s27, internal_force_s27, &
-            velocity_gradient_s27, g2p_s27
+            velocity_gradient_s27, g2p_s27, gradient_g2p_s27
 
 contains
 
@@ -339,5 +339,54 @@ contains
       end if
     end do
   end subroutine g2p_s27
+
+  !> The two of [[velocity_gradient_s27]] and [[g2p_s27]] (with `add`) on the same nodal field
+  !> in one pass: L_p = Σ v_I ⊗ ∇N_Ip into L(:, :, 1..p1−p0+1) and u_p += cs Σ N_Ip v_I, each
+  !> sum in its own kernel's order (the same bits); the factors are formed and the nodes read
+  !> once.
+  pure subroutine gradient_g2p_s27(s, s2, h, p0, p1, cell, t, gimp, wg, v, L, cs, u)
+    integer, intent(in) :: s                 !! nodes along x
+    integer, intent(in) :: s2                !! nodes per x-y plane
+    real(wp), intent(in) :: h(3)             !! 1/h per direction
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: cell(*)           !! first node of each particle's stencil
+    real(wp), intent(in) :: t(3, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 3, *)   !! uGIMP: values, slopes per direction
+    real(wp), intent(in) :: v(3, *)          !! nodal velocities
+    real(wp), intent(inout) :: L(3, 3, *)    !! velocity gradients
+    real(wp), intent(in) :: cs               !! scale of the interpolated velocity
+    real(wp), intent(inout) :: u(3, *)       !! particle vectors (accumulated)
+    real(wp) :: w(3, 3), g(3, 3), lx(3), ly(3), lz(3), sm(3), w23
+    integer :: p, a, b, c
+    integer(int64) :: I
+    !GCC$ novector
+    do p = p0, p1
+      if (gimp) then
+        w = wg(:, 1, :, p); g = wg(:, 2, :, p)
+      else
+        call b9_factors(t(1, p), h(1), w(:, 1), g(:, 1))
+        call b9_factors(t(2, p), h(2), w(:, 2), g(:, 2))
+        call b9_factors(t(3, p), h(3), w(:, 3), g(:, 3))
+      end if
+      lx = 0.0_wp; ly = 0.0_wp; lz = 0.0_wp; sm = 0.0_wp
+      do c = 1, 3
+        do b = 1, 3
+          w23 = w(b, 2) * w(c, 3)
+          I = cell(p) + int(s, int64) * (b - 1) + int(s2, int64) * (c - 1)
+          do a = 1, 3
+            lx = lx + v(:, I) * (g(a, 1) * w23)
+            ly = ly + v(:, I) * (g(b, 2) * (w(a, 1) * w(c, 3)))
+            lz = lz + v(:, I) * (g(c, 3) * (w(a, 1) * w(b, 2)))
+            sm = sm + (w(a, 1) * w23) * v(:, I)
+            I = I + 1
+          end do
+        end do
+      end do
+      L(:, 1, p - p0 + 1) = lx; L(:, 2, p - p0 + 1) = ly; L(:, 3, p - p0 + 1) = lz
+      u(:, p) = u(:, p) + cs * sm
+    end do
+  end subroutine gradient_g2p_s27
 
 end module empm_transfer_s27

@@ -25,7 +25,7 @@ module empm_transfer_s9
   implicit none
   private
   public :: mass_s9, weighted_s9, mass_momentum_s9, body_force_s9, internal_force_s9, &
-            velocity_gradient_s9, g2p_s9
+            velocity_gradient_s9, g2p_s9, gradient_g2p_s9
 
 contains
 
@@ -309,5 +309,48 @@ contains
       end if
     end do
   end subroutine g2p_s9
+
+  !> The two of [[velocity_gradient_s9]] and [[g2p_s9]] (with `add`) on the same nodal field in
+  !> one pass: L_p = Σ v_I ⊗ ∇N_Ip into L(:, :, 1..p1−p0+1) and u_p += c Σ N_Ip v_I, each sum in
+  !> its own kernel's order (the same bits); the factors are formed and the nodes read once.
+  pure subroutine gradient_g2p_s9(s, h, p0, p1, cell, t, gimp, wg, v, L, c, u)
+    integer, intent(in) :: s                 !! nodes along x
+    real(wp), intent(in) :: h(2)             !! 1/h per direction
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: cell(*)           !! first node of each particle's stencil
+    real(wp), intent(in) :: t(2, *)          !! local coordinates
+    logical, intent(in) :: gimp              !! uGIMP: factors stored in `wg` (else B-splines)
+    real(wp), intent(in) :: wg(3, 2, 2, *)   !! uGIMP: values, slopes per direction
+    real(wp), intent(in) :: v(2, *)          !! nodal velocities
+    real(wp), intent(inout) :: L(3, 3, *)    !! velocity gradients (2×2 block written)
+    real(wp), intent(in) :: c                !! scale of the interpolated velocity
+    real(wp), intent(inout) :: u(2, *)       !! particle vectors (accumulated)
+    real(wp) :: wx(3), gx(3), wy(3), gy(3), lx(2), ly(2), sm(2)
+    integer :: p, a, b
+    integer(int64) :: I
+    !GCC$ novector
+    do p = p0, p1
+      if (gimp) then
+        wx = wg(:, 1, 1, p); gx = wg(:, 2, 1, p)
+        wy = wg(:, 1, 2, p); gy = wg(:, 2, 2, p)
+      else
+        call b9_factors(t(1, p), h(1), wx, gx)
+        call b9_factors(t(2, p), h(2), wy, gy)
+      end if
+      lx = 0.0_wp; ly = 0.0_wp; sm = 0.0_wp
+      do b = 1, 3
+        I = cell(p) + int(s, int64) * (b - 1)
+        do a = 1, 3
+          lx = lx + v(:, I) * (gx(a) * wy(b))
+          ly = ly + v(:, I) * (gy(b) * wx(a))
+          sm = sm + (wx(a) * wy(b)) * v(:, I)
+          I = I + 1
+        end do
+      end do
+      L(1:2, 1, p - p0 + 1) = lx; L(1:2, 2, p - p0 + 1) = ly
+      u(:, p) = u(:, p) + c * sm
+    end do
+  end subroutine gradient_g2p_s9
 
 end module empm_transfer_s9
