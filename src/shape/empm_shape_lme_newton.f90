@@ -149,7 +149,7 @@ contains
     real(wp) :: cmean(3), cov(3, 3), cinv(3, 3), v(3), s, ximax, x2, x2max, scl, cen(3), cent(3)
     real(wp) :: xlo(3), xhi(3)
     integer :: a, i, nact
-    logical :: varying, ok, qvalid, fast2d, early, far
+    logical :: varying, ok, qvalid, fast2d, fast3d, early, far
 
     iters = 0
     info = SHAPE_OK
@@ -159,6 +159,7 @@ contains
     nact = 0
     varying = present(gnode) .and. present(node)
     fast2d = nd == 2 .and. .not. varying
+    fast3d = nd == 3 .and. .not. varying
     ! 3D with uniform γ stops as the lean 2D path does, on a bound of the residual after the
     ! final linearised step (1D keeps the test on ‖r‖ alone: its verification results rest on it).
     early = nd == 3 .and. .not. varying
@@ -188,6 +189,29 @@ contains
             xhi(1) = max(xhi(1), dN(1, a))
             xlo(2) = min(xlo(2), dN(2, a))
             xhi(2) = max(xhi(2), dN(2, a))
+          else
+            N(a) = -1.0_wp
+          end if
+        end do
+      else if (fast3d) then
+        ! 3D with scalars: the general loop's expressions (its sum adds from the first term).
+        do a = 1, nc
+          x2 = (dN(1, a)**2 + dN(2, a)**2) + dN(3, a)**2
+          q = gamma * x2
+          if (q <= cut) then
+            N(a) = 0.0_wp
+            nact = nact + 1
+            qmax = max(qmax, q)
+            x2max = max(x2max, x2)
+            cmean(1) = cmean(1) + dN(1, a)
+            cmean(2) = cmean(2) + dN(2, a)
+            cmean(3) = cmean(3) + dN(3, a)
+            xlo(1) = min(xlo(1), dN(1, a))
+            xhi(1) = max(xhi(1), dN(1, a))
+            xlo(2) = min(xlo(2), dN(2, a))
+            xhi(2) = max(xhi(2), dN(2, a))
+            xlo(3) = min(xlo(3), dN(3, a))
+            xhi(3) = max(xhi(3), dN(3, a))
           else
             N(a) = -1.0_wp
           end if
@@ -234,6 +258,21 @@ contains
           cov(2, 2) = cov(2, 2) + y(2) * y(2)
         end do
         cov(1, 2) = cov(2, 1)
+      else if (fast3d) then
+        ! As the general loop, with scalars (cov(i, j) = cov(j, i) exactly there too).
+        do a = 1, nc
+          if (N(a) < 0.0_wp) cycle
+          y(1) = dN(1, a) - cmean(1)
+          y(2) = dN(2, a) - cmean(2)
+          y(3) = dN(3, a) - cmean(3)
+          cov(1, 1) = cov(1, 1) + y(1) * y(1)
+          cov(2, 1) = cov(2, 1) + y(2) * y(1)
+          cov(3, 1) = cov(3, 1) + y(3) * y(1)
+          cov(2, 2) = cov(2, 2) + y(2) * y(2)
+          cov(3, 2) = cov(3, 2) + y(3) * y(2)
+          cov(3, 3) = cov(3, 3) + y(3) * y(3)
+        end do
+        cov(1, 2) = cov(2, 1); cov(1, 3) = cov(3, 1); cov(2, 3) = cov(3, 2)
       else
         do a = 1, nc
           if (N(a) < 0.0_wp) cycle
@@ -365,7 +404,19 @@ contains
           v(3) = dN(3, a) - r(3)
           p = N(a) * (1.0_wp + (((0.0_wp + v(1) * del(1)) + v(2) * del(2)) + v(3) * del(3)))
           N(a) = p
-          call add_moments_3d(p, dN(:, a), cen, s, rt, jt)
+          ! The sums about cen as in the general loop (all nine jt(i, j)), written out.
+          s = s + p
+          v(1) = dN(1, a) - cen(1)
+          v(2) = dN(2, a) - cen(2)
+          v(3) = dN(3, a) - cen(3)
+          rt(1) = rt(1) + p * v(1)
+          rt(2) = rt(2) + p * v(2)
+          rt(3) = rt(3) + p * v(3)
+          do i = 1, 3
+            jt(1, i) = jt(1, i) + (p * v(i)) * v(1)
+            jt(2, i) = jt(2, i) + (p * v(i)) * v(2)
+            jt(3, i) = jt(3, i) + (p * v(i)) * v(3)
+          end do
         end do
       else
         do a = 1, nc
@@ -432,7 +483,10 @@ contains
           v(1) = dN(1, a) - r(1)
           v(2) = dN(2, a) - r(2)
           v(3) = dN(3, a) - r(3)
-          y = matvec(3, jinv, v)
+          ! matvec's sums, from the same zero.
+          y(1) = ((0.0_wp + jinv(1, 1) * v(1)) + jinv(1, 2) * v(2)) + jinv(1, 3) * v(3)
+          y(2) = ((0.0_wp + jinv(2, 1) * v(1)) + jinv(2, 2) * v(2)) + jinv(2, 3) * v(3)
+          y(3) = ((0.0_wp + jinv(3, 1) * v(1)) + jinv(3, 2) * v(2)) + jinv(3, 3) * v(3)
           dN(1, a) = -N(a) * y(1) / h
           dN(2, a) = -N(a) * y(2) / h
           dN(3, a) = -N(a) * y(3) / h
@@ -555,11 +609,31 @@ contains
         end if
       end do
       if (amax > 0) c(1:3) = xi(1:3, amax)
+      ! The weights first, then their sums: an exp call in the summing loop made every
+      ! accumulator spill around it (the SSE registers are caller-saved). Not vectorised:
+      ! the vector exp may round differently from the scalar one, the general loop's.
+      !GCC$ novector
       do a = 1, nc
         if (w(a) < 0.0_wp) cycle
-        e = exp(fa(a) - fmax)
-        w(a) = e
-        call add_moments_3d(e, xi(:, a), c, s, sr, sj)
+        w(a) = exp(fa(a) - fmax)
+      end do
+      do a = 1, nc
+        if (w(a) < 0.0_wp) cycle
+        e = w(a)
+        ! S0 += e, S1 += e u, S2 += (e u_i) u_j (all nine), u = ξ − c: the general loop's
+        ! sums written out (a call per node was 20 % of a 3D LME step).
+        s = s + e
+        u(1) = xi(1, a) - c(1)
+        u(2) = xi(2, a) - c(2)
+        u(3) = xi(3, a) - c(3)
+        sr(1) = sr(1) + e * u(1)
+        sr(2) = sr(2) + e * u(2)
+        sr(3) = sr(3) + e * u(3)
+        do i = 1, 3
+          sj(1, i) = sj(1, i) + (e * u(i)) * u(1)
+          sj(2, i) = sj(2, i) + (e * u(i)) * u(2)
+          sj(3, i) = sj(3, i) + (e * u(i)) * u(3)
+        end do
       end do
     else
       do a = 1, nc
@@ -703,27 +777,6 @@ contains
       norm_small = norm2(v(1:nd))
     end if
   end function norm_small
-
-  ! One 3D node's weight e at ξ added to the sums about c: S0 += e, S1 += e u, S2 += (e u_i) u_j
-  ! (all nine, in the general loops' order), u = ξ − c.
-  pure subroutine add_moments_3d(e, xi, c, s0, s1, s2)
-    real(wp), intent(in) :: e, xi(:), c(3)
-    real(wp), intent(inout) :: s0, s1(3), s2(3, 3)
-    real(wp) :: u(3)
-    integer :: i
-    s0 = s0 + e
-    u(1) = xi(1) - c(1)
-    u(2) = xi(2) - c(2)
-    u(3) = xi(3) - c(3)
-    s1(1) = s1(1) + e * u(1)
-    s1(2) = s1(2) + e * u(2)
-    s1(3) = s1(3) + e * u(3)
-    do i = 1, 3
-      s2(1, i) = s2(1, i) + (e * u(i)) * u(1)
-      s2(2, i) = s2(2, i) + (e * u(i)) * u(2)
-      s2(3, i) = s2(3, i) + (e * u(i)) * u(3)
-    end do
-  end subroutine add_moments_3d
 
   !> y = A v for the leading nd×nd block (explicit loops: no temporaries).
   pure function matvec(nd, a, v) result(y)
