@@ -306,30 +306,46 @@ contains
   !> images; with the extension of nearly-empty nodes on ([[empm_extension]]), find them (their
   !> filled volumes in one more P2G) and gather the masses, m̂ = Eᵀm. Without mirrors and
   !> degenerate nodes nothing changes. (A carried basis keeps its masses: [[map_velocity]].)
-  subroutine extend_masses(self, model, again)
+  subroutine extend_masses(self, model, again, mapped)
     class(empm_integrator_t), intent(inout) :: self   !! integrator (P2G workspace)
     type(empm_model_t), intent(inout) :: model        !! simulation state
     logical, intent(in), optional :: again            !! the basis repeats the last evaluation
                                                       !! (a carried basis made again): its
                                                       !! fill is that of the volumes it used
-    logical :: repeat
-    integer :: np
-    repeat = .false.
-    if (present(again)) repeat = again
+    logical, intent(in), optional :: mapped           !! the caller's P2G already summed the
+                                                      !! fill volumes into `nodes%vol`
+                                                      !! ([[fill_volumes_ready]])
+    logical :: done
+    done = .false.
+    if (present(mapped)) done = mapped
     associate (nodes => model%nodes)
       if (nodes%nmirror > 0) call nodes%mirror_gather_mass()
       if (nodes%ext%theta <= 0.0_wp) return
-      ! The fill of a carried basis comes from the volumes before the step's stress update;
-      ! a restart or a re-cut that evaluates it again must see the same ones.
-      np = model%pts%np
-      if (.not. repeat) model%pts%vol_fill(1:np) = model%pts%vol(1:np)
-      nodes%vol = 0.0_wp
-      call p2g_mass(model%basis, model%pts%vol_fill, nodes%vol, self%p2g)
+      if (.not. done) then
+        call fill_volumes_ready(model, again)
+        call p2g_mass(model%basis, model%pts%vol_fill, nodes%vol, self%p2g)
+      end if
       call model%halo%sum(model%comm, nodes%vol)
       call nodes%find_degenerate(model%grid)
       if (nodes%ext%n > 0) call nodes%ext%gather_mass(nodes%mass)
     end associate
   end subroutine extend_masses
+
+  !> Before the P2G of the fill volumes (with the nearly-empty-node rule on): the particles'
+  !> fill volumes `pts%vol_fill` and `nodes%vol` zeroed. The fill of a carried basis comes from
+  !> the volumes before the step's stress update; a restart or a re-cut that evaluates it again
+  !> (`again`) must see the same ones, so they are kept then.
+  subroutine fill_volumes_ready(model, again)
+    type(empm_model_t), intent(inout) :: model        !! simulation state
+    logical, intent(in), optional :: again            !! the basis repeats the last evaluation
+    logical :: repeat
+    integer :: np
+    repeat = .false.
+    if (present(again)) repeat = again
+    np = model%pts%np
+    if (.not. repeat) model%pts%vol_fill(1:np) = model%pts%vol(1:np)
+    model%nodes%vol = 0.0_wp
+  end subroutine fill_volumes_ready
 
   !> The particle state was replaced from outside the step (a restart or a guard's replay put
   !> back a saved state): a basis carried from the last step is stale. A scheme that carries
@@ -374,7 +390,8 @@ contains
     type(empm_step_status_t), intent(inout) :: stat   !! set on failure
     real(wp), intent(in), optional :: c               !! scale of `w`
     real(wp), intent(in), contiguous, optional :: w(:,:) !! second particle vectors (ndim, np)
-    logical :: again
+    logical :: again, fill
+    real(wp) :: cw
     associate (nodes => model%nodes, pts => model%pts, basis => model%basis, tm => self%timer)
       call tm%mark()
       if (self%basis_ready) then
@@ -395,15 +412,29 @@ contains
         call tm%lap(PHASE_SHAPE)
         if (stat%code /= 0) return
         call nodes%reset()
+        ! With the nearly-empty-node rule the fill volumes are summed in the same pass.
+        fill = nodes%ext%theta > 0.0_wp
+        if (fill) call fill_volumes_ready(model, again)
         if (present(c) .and. present(w)) then
-          call p2g_mass_momentum(basis, pts%m, pts%v, c, w, nodes%mass, nodes%mom, self%p2g)
+          cw = c
         else
-          call p2g_mass_momentum(basis, pts%m, pts%v, 0.0_wp, pts%v, nodes%mass, nodes%mom, &
+          cw = 0.0_wp
+        end if
+        if (fill .and. present(w)) then
+          call p2g_mass_momentum(basis, pts%m, pts%v, cw, w, nodes%mass, nodes%mom, self%p2g, &
+                                 pts%vol_fill, nodes%vol)
+        else if (fill) then
+          call p2g_mass_momentum(basis, pts%m, pts%v, cw, pts%v, nodes%mass, nodes%mom, &
+                                 self%p2g, pts%vol_fill, nodes%vol)
+        else if (present(w)) then
+          call p2g_mass_momentum(basis, pts%m, pts%v, cw, w, nodes%mass, nodes%mom, self%p2g)
+        else
+          call p2g_mass_momentum(basis, pts%m, pts%v, cw, pts%v, nodes%mass, nodes%mom, &
                                  self%p2g)
         end if
         call model%halo%sum(model%comm, nodes%mass)
         call model%halo%sum(model%comm, nodes%mom)
-        call extend_masses(self, model, again)
+        call extend_masses(self, model, again, mapped=fill)
       end if
       call tm%lap(PHASE_P2G)
       call nodal_divide_by_mass(nodes, nodes%mom, nodes%vel)

@@ -60,6 +60,7 @@ module empm_transfer
     logical :: two_phase = .false.          !! the current basis allows the two-phase mode
     real(wp), allocatable :: buf(:,:,:)     !! vector accumulators of chunks 2..nt (ndim, nnode, nt-1)
     real(wp), allocatable :: mbuf(:,:)      !! scalar (mass) accumulators of chunks 2..nt (nnode, nt-1)
+    real(wp), allocatable :: vbuf(:,:)      !! second scalar (fill volume) accumulators (nnode, nt-1)
     integer, allocatable :: lo(:)           !! first node touched by each chunk (nt); set by
                                             !! set_ranges after every basis evaluation
     integer, allocatable :: hi(:)           !! last node touched by each chunk (nt)
@@ -77,6 +78,7 @@ module empm_transfer
   integer, parameter :: OP_MASS_MOMENTUM = 3  ! m_I and q_I in one pass ([[p2g_mass_momentum]])
   integer, parameter :: OP_INTERNAL_FORCE = 4 ! internal force ([[p2g_internal_force]])
   integer, parameter :: OP_BODY_FORCE = 5     ! body force ([[p2g_body_force]])
+  integer, parameter :: OP_MASS_MOMENTUM_FILL = 6 ! m_I, q_I and the fill volumes V_I in one pass
 
 contains
 
@@ -90,10 +92,12 @@ contains
     integer, intent(in) :: nthreads               !! threads to use
     self%nt = max(1, nthreads)
     if (np < EMPM_OMP_MIN_PARTICLES) self%nt = 1
-    if (allocated(self%buf)) deallocate(self%buf, self%mbuf, self%lo, self%hi, self%slo, self%shi)
+    if (allocated(self%buf)) deallocate(self%buf, self%mbuf, self%vbuf, self%lo, self%hi, &
+                                        self%slo, self%shi)
     allocate(self%buf(ndim, nnode, self%nt - 1), self%mbuf(nnode, self%nt - 1), &
-             self%lo(self%nt), self%hi(self%nt), self%slo(2 * self%nt), self%shi(2 * self%nt))
-    self%buf = 0.0_wp; self%mbuf = 0.0_wp
+             self%vbuf(nnode, self%nt - 1), self%lo(self%nt), self%hi(self%nt), &
+             self%slo(2 * self%nt), self%shi(2 * self%nt))
+    self%buf = 0.0_wp; self%mbuf = 0.0_wp; self%vbuf = 0.0_wp
     self%lo = 1; self%hi = 0; self%slo = 1; self%shi = 0
     self%two_phase = .false.
   end subroutine p2g_work_init
@@ -107,9 +111,10 @@ contains
     if (self%nt <= 1 .or. .not. allocated(self%buf)) return
     if (size(self%buf, 2) == nnode) return
     nd = size(self%buf, 1)
-    deallocate(self%buf, self%mbuf)
-    allocate(self%buf(nd, nnode, self%nt - 1), self%mbuf(nnode, self%nt - 1))
-    self%buf = 0.0_wp; self%mbuf = 0.0_wp
+    deallocate(self%buf, self%mbuf, self%vbuf)
+    allocate(self%buf(nd, nnode, self%nt - 1), self%mbuf(nnode, self%nt - 1), &
+             self%vbuf(nnode, self%nt - 1))
+    self%buf = 0.0_wp; self%mbuf = 0.0_wp; self%vbuf = 0.0_wp
   end subroutine p2g_work_fit
 
   !> Record the node range touched by each particle sub-chunk and chunk for the current basis
@@ -219,9 +224,11 @@ contains
     !$omp end do
   end subroutine reduce_vec
 
-  !> As [[reduce_vec]] for a scalar nodal field (the scalar buffers).
-  subroutine reduce_scalar(ws, q)
-    type(empm_p2g_work_t), intent(inout) :: ws !! threaded-P2G workspace (buffers zeroed)
+  !> As [[reduce_vec]] for a scalar nodal field, from the scalar buffers `sbuf` (`ws%mbuf` or
+  !> `ws%vbuf`).
+  subroutine reduce_scalar(ws, sbuf, q)
+    type(empm_p2g_work_t), intent(in) :: ws    !! threaded-P2G workspace (modes, ranges)
+    real(wp), intent(inout) :: sbuf(:,:)       !! its scalar buffers (zeroed)
     real(wp), intent(inout) :: q(:)            !! nodal scalars (accumulated)
     integer :: I, c, ilo, ihi
     if (ws%two_phase) return ! nothing in the buffers
@@ -230,8 +237,8 @@ contains
     do I = ilo, ihi
       do c = 2, ws%nt
         if (I < ws%lo(c) .or. I > ws%hi(c)) cycle
-        q(I) = q(I) + ws%mbuf(I, c - 1)
-        ws%mbuf(I, c - 1) = 0.0_wp
+        q(I) = q(I) + sbuf(I, c - 1)
+        sbuf(I, c - 1) = 0.0_wp
       end do
     end do
     !$omp end do
@@ -243,9 +250,9 @@ contains
     real(wp), intent(in) :: m(:)                             !! particle masses
     real(wp), intent(inout), contiguous :: mass(:)           !! nodal masses (accumulated)
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    real(wp) :: none1(0), none2(0, 0)
+    real(wp) :: none1(0), none2(0, 0), nv(0)
     call p2g_drive(OP_MASS, basis, ws, m, none2, 0.0_wp, none2, none1, none2, none1, none2, &
-                   .false., mass, none2)
+                   .false., mass, none2, nv)
   end subroutine p2g_mass
 
   !> Mass-weighted transfer q_I += Σ_p N_Ip m_p (u_p + c·w_p), e.g. momentum (c = 0) or the
@@ -258,15 +265,17 @@ contains
     real(wp), intent(in), contiguous :: w(:,:)               !! second particle vectors (ndim, np)
     real(wp), intent(inout), contiguous :: q(:,:)            !! nodal vectors (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    real(wp) :: none1(0), none2(0, 0)
+    real(wp) :: none1(0), none2(0, 0), nv(0)
     call p2g_drive(OP_WEIGHTED, basis, ws, m, u, c, w, none1, none2, none1, none2, .false., &
-                   none1, q)
+                   none1, q, nv)
   end subroutine p2g_weighted
 
   !> Lumped mass and a mass-weighted vector in one pass over the particles:
   !> m_I += Σ_p N_Ip m_p and q_I += Σ_p N_Ip m_p (u_p + c·w_p). The same sums as
-  !> [[p2g_mass]] followed by [[p2g_weighted]], bit for bit, reading the basis once.
-  subroutine p2g_mass_momentum(basis, m, u, c, w, mass, q, ws)
+  !> [[p2g_mass]] followed by [[p2g_weighted]], bit for bit, reading the basis once. With
+  !> `vfill` and `vnode`, also the nodal fill volumes vnode_I += Σ_p N_Ip vfill_p in the same
+  !> pass (the sums of a separate [[p2g_mass]] of `vfill`, bit for bit).
+  subroutine p2g_mass_momentum(basis, m, u, c, w, mass, q, ws, vfill, vnode)
     type(empm_basis_t), intent(in) :: basis                  !! shape functions at the particles
     real(wp), intent(in) :: m(:)                             !! particle masses
     real(wp), intent(in), contiguous :: u(:,:)               !! particle vectors (ndim, np)
@@ -275,9 +284,16 @@ contains
     real(wp), intent(inout), contiguous :: mass(:)           !! nodal masses (accumulated)
     real(wp), intent(inout), contiguous :: q(:,:)            !! nodal vectors (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    real(wp) :: none1(0), none2(0, 0)
-    call p2g_drive(OP_MASS_MOMENTUM, basis, ws, m, u, c, w, none1, none2, none1, none2, &
-                   .false., mass, q)
+    real(wp), intent(in), optional :: vfill(:)               !! particle volumes of the fill test
+    real(wp), intent(inout), contiguous, optional :: vnode(:) !! nodal fill volumes (accumulated)
+    real(wp) :: none1(0), none2(0, 0), nv(0)
+    if (present(vfill) .and. present(vnode)) then
+      call p2g_drive(OP_MASS_MOMENTUM_FILL, basis, ws, m, u, c, w, vfill, none2, none1, none2, &
+                     .false., mass, q, vnode)
+    else
+      call p2g_drive(OP_MASS_MOMENTUM, basis, ws, m, u, c, w, none1, none2, none1, none2, &
+                     .false., mass, q, nv)
+    end if
   end subroutine p2g_mass_momentum
 
   !> Internal force f_I −= Σ_p V_p σ_p ∇N_Ip (paper eq. 16), σ in Voigt order.
@@ -287,9 +303,9 @@ contains
     real(wp), intent(in), contiguous :: stress(:,:)          !! Cauchy stress (6, np)
     real(wp), intent(inout), contiguous :: f(:,:)            !! nodal forces (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    real(wp) :: none1(0), none2(0, 0)
+    real(wp) :: none1(0), none2(0, 0), nv(0)
     call p2g_drive(OP_INTERNAL_FORCE, basis, ws, none1, none2, 0.0_wp, none2, vol, stress, none1, &
-                   none2, .false., none1, f)
+                   none2, .false., none1, f, nv)
   end subroutine p2g_internal_force
 
   !> External body force f_I += Σ_p N_Ip m_p (g + b_p) (paper eq. 17 without tractions).
@@ -301,11 +317,11 @@ contains
     logical, intent(in) :: use_b                             !! whether `b` holds data
     real(wp), intent(inout), contiguous :: f(:,:)            !! nodal forces (ndim, nnode), accumulated
     type(empm_p2g_work_t), intent(inout), optional :: ws     !! threaded-P2G workspace
-    real(wp) :: none1(0), none2(0, 0)
+    real(wp) :: none1(0), none2(0, 0), nv(0)
     ! Nothing to add: skip the pass (adding zeros leaves f unchanged bit for bit).
     if (.not. use_b .and. all(g == 0.0_wp)) return
     call p2g_drive(OP_BODY_FORCE, basis, ws, m, none2, 0.0_wp, none2, none1, none2, g, b, use_b, &
-                   none1, f)
+                   none1, f, nv)
   end subroutine p2g_body_force
 
   !> The P2G skeleton of every `p2g_*` above: accumulate the sums `op` selects into `mass`
@@ -314,7 +330,7 @@ contains
   !> chunk's buffers, and the buffers are reduced into the targets `op` writes. The arguments
   !> `op` does not read are zero-size arrays (not absent optional ones: gfortran forms the
   !> descriptor of an absent array argument from a null pointer, which UBSan rightly reports).
-  subroutine p2g_drive(op, basis, ws, m, u, c, w, vol, stress, g, b, use_b, mass, q)
+  subroutine p2g_drive(op, basis, ws, m, u, c, w, vol, stress, g, b, use_b, mass, q, vn)
     integer, intent(in) :: op                                       !! OP_* selector
     type(empm_basis_t), intent(in) :: basis                         !! shape functions at the particles
     type(empm_p2g_work_t), intent(inout), optional :: ws            !! threaded-P2G workspace
@@ -322,41 +338,46 @@ contains
     real(wp), intent(in), contiguous :: u(:,:)            !! particle vectors (ndim, np)
     real(wp), intent(in) :: c                             !! scale of `w` (0 to ignore it)
     real(wp), intent(in), contiguous :: w(:,:)            !! second particle vectors (ndim, np)
-    real(wp), intent(in) :: vol(:)                        !! particle volumes
+    real(wp), intent(in) :: vol(:)                        !! particle volumes (OP_MASS_MOMENTUM_FILL:
+                                                          !! of the fill test)
     real(wp), intent(in), contiguous :: stress(:,:)       !! Cauchy stress (6, np)
     real(wp), intent(in) :: g(:)                          !! uniform acceleration (ndim)
     real(wp), intent(in) :: b(:,:)                        !! body force per unit mass (ndim, np)
     logical, intent(in) :: use_b                          !! whether `b` holds data
     real(wp), intent(inout), contiguous :: mass(:)        !! nodal scalars (accumulated)
     real(wp), intent(inout), contiguous :: q(:,:)         !! nodal vectors (ndim, nnode), accumulated
+    real(wp), intent(inout), contiguous :: vn(:)          !! nodal fill volumes (accumulated;
+                                                          !! OP_MASS_MOMENTUM_FILL only)
     integer :: it, p0, p1, ph, dst
     if (.not. threaded(ws)) then
-      call p2g_range(op, basis, 1, basis%np, m, u, c, w, vol, stress, g, b, use_b, mass, q)
+      call p2g_range(op, basis, 1, basis%np, m, u, c, w, vol, stress, g, b, use_b, mass, q, vn)
       return
     end if
     !$omp parallel num_threads(ws%nt) default(none) private(ph, it, p0, p1, dst) &
-    !$omp   shared(op, basis, ws, m, u, c, w, vol, stress, g, b, use_b, mass, q)
+    !$omp   shared(op, basis, ws, m, u, c, w, vol, stress, g, b, use_b, mass, q, vn)
     do ph = 1, p2g_phases(ws)
       !$omp do schedule(static, 1)
       do it = 1, ws%nt
         call p2g_task(ws, basis%np, ph, it, p0, p1, dst)
         if (dst == 0) then
-          call p2g_range(op, basis, p0, p1, m, u, c, w, vol, stress, g, b, use_b, mass, q)
+          call p2g_range(op, basis, p0, p1, m, u, c, w, vol, stress, g, b, use_b, mass, q, vn)
         else
           call p2g_range(op, basis, p0, p1, m, u, c, w, vol, stress, g, b, use_b, &
-                         ws%mbuf(:, dst), ws%buf(:, :, dst))
+                         ws%mbuf(:, dst), ws%buf(:, :, dst), ws%vbuf(:, dst))
         end if
       end do
       !$omp end do
     end do
-    if (op == OP_MASS .or. op == OP_MASS_MOMENTUM) call reduce_scalar(ws, mass)
+    if (op == OP_MASS .or. op == OP_MASS_MOMENTUM .or. op == OP_MASS_MOMENTUM_FILL) &
+      call reduce_scalar(ws, ws%mbuf, mass)
+    if (op == OP_MASS_MOMENTUM_FILL) call reduce_scalar(ws, ws%vbuf, vn)
     if (op /= OP_MASS) call reduce_vec(ws, q)
     !$omp end parallel
   end subroutine p2g_drive
 
   !> Particles p0..p1 of the P2G pass `op` into `mass` and/or `q`: the one dispatch on the
   !> pass, once per particle range (never per particle).
-  pure subroutine p2g_range(op, basis, p0, p1, m, u, c, w, vol, stress, g, b, use_b, mass, q)
+  pure subroutine p2g_range(op, basis, p0, p1, m, u, c, w, vol, stress, g, b, use_b, mass, q, vn)
     integer, intent(in) :: op                                       !! OP_* selector
     type(empm_basis_t), intent(in) :: basis                         !! shape functions at the particles
     integer, intent(in) :: p0                                       !! first particle
@@ -372,13 +393,16 @@ contains
     logical, intent(in) :: use_b                          !! whether `b` holds data
     real(wp), intent(inout), contiguous :: mass(:)        !! nodal scalars (accumulated)
     real(wp), intent(inout), contiguous :: q(:,:)         !! nodal vectors (ndim, nnode), accumulated
+    real(wp), intent(inout), contiguous :: vn(:)          !! nodal fill volumes (accumulated)
     select case (op)
     case (OP_MASS)
       call mass_range(basis, m, p0, p1, mass)
     case (OP_WEIGHTED)
       call weighted_range(basis, m, u, c, w, p0, p1, q)
     case (OP_MASS_MOMENTUM)
-      call mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q)
+      call mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q, .false., vol, vn)
+    case (OP_MASS_MOMENTUM_FILL)
+      call mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q, .true., vol, vn)
     case (OP_INTERNAL_FORCE)
       call internal_range(basis, vol, stress, p0, p1, q)
     case (OP_BODY_FORCE)
@@ -451,8 +475,9 @@ contains
     end do
   end subroutine weighted_range
 
-  !> [[mass_range]] and [[weighted_range]] in one pass over particles p0..p1 (the same bits).
-  pure subroutine mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q)
+  !> [[mass_range]] and [[weighted_range]] in one pass over particles p0..p1 (the same bits);
+  !> with `fill` also the [[mass_range]] of `vol` into `vn`.
+  pure subroutine mass_momentum_range(basis, m, u, c, w, p0, p1, mass, q, fill, vol, vn)
     type(empm_basis_t), intent(in) :: basis              !! shape functions at the particles
     real(wp), intent(in) :: m(:)                         !! particle masses
     real(wp), intent(in), contiguous :: u(:,:)           !! particle vectors (ndim, np)
@@ -462,21 +487,26 @@ contains
     integer, intent(in) :: p1                            !! last particle
     real(wp), intent(inout), contiguous :: mass(:)       !! nodal masses (accumulated)
     real(wp), intent(inout), contiguous :: q(:,:)        !! nodal vectors (ndim, nnode), accumulated
+    logical, intent(in) :: fill                          !! also the fill volumes
+    real(wp), intent(in) :: vol(:)                       !! particle fill volumes (with `fill`)
+    real(wp), intent(inout), contiguous :: vn(:)         !! nodal fill volumes (with `fill`)
     if (basis%layout == BASIS_Q4) then
-      call mass_momentum_q4(basis%stride, p0, p1, basis%cell, basis%t, m, u, c, w, mass, q)
+      call mass_momentum_q4(basis%stride, p0, p1, basis%cell, basis%t, m, u, c, w, mass, q, &
+                            fill, vol, vn)
     else if (is_s9(basis)) then
       call mass_momentum_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
                             basis%layout == BASIS_G9, basis%wg, m, u, c, w, &
-                            mass, q)
+                            mass, q, fill, vol, vn)
     else if (is_s27(basis)) then
       call mass_momentum_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
-                             basis%layout == BASIS_G27, basis%wg, m, u, c, w, mass, q)
+                             basis%layout == BASIS_G27, basis%wg, m, u, c, w, mass, q, fill, vol, vn)
     else if (basis%ndim == 2) then
       call mass_momentum_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, m, u, c, w, &
-                            mass, q)
+                            mass, q, fill, vol, vn)
     else
       call mass_range(basis, m, p0, p1, mass)
       call weighted_range(basis, m, u, c, w, p0, p1, q)
+      if (fill) call mass_range(basis, vol, p0, p1, vn)
     end if
   end subroutine mass_momentum_range
 

@@ -18,8 +18,9 @@ module empm_transfer_2d
 
 contains
 
-  !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (c = 0 ignores w).
-  pure subroutine mass_momentum_2d(mx, p0, p1, nn, node, N, m, u, c, w, mass, q)
+  !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (c = 0 ignores w); with
+  !> `fill` also V_I += Σ N_Ip vol_p (the fill volumes).
+  pure subroutine mass_momentum_2d(mx, p0, p1, nn, node, N, m, u, c, w, mass, q, fill, vol, vn)
     integer, intent(in) :: mx                !! basis capacity (nodes per particle)
     integer, intent(in) :: p0                !! first particle
     integer, intent(in) :: p1                !! last particle
@@ -32,6 +33,9 @@ contains
     real(wp), intent(in) :: w(2, *)          !! second particle vectors
     real(wp), intent(inout) :: mass(*)       !! nodal masses (accumulated)
     real(wp), intent(inout) :: q(2, *)       !! nodal vectors (accumulated)
+    logical, intent(in) :: fill              !! also the fill volumes
+    real(wp), intent(in) :: vol(*)           !! particle fill volumes (with `fill`)
+    real(wp), intent(inout) :: vn(*)         !! nodal fill volumes (with `fill`; accumulated)
     real(wp) :: mu(2), nk
     integer :: p, k, I
     ! Two-component vector operations throughout: the compiler packs them into SIMD pairs.
@@ -45,6 +49,7 @@ contains
         I = node(k, p); nk = N(k, p)
         mass(I) = mass(I) + nk * m(p)
         q(:, I) = q(:, I) + nk * mu
+        if (fill) vn(I) = vn(I) + nk * vol(p)
       end do
     end do
   end subroutine mass_momentum_2d

@@ -76,8 +76,9 @@ contains
     end do
   end subroutine weighted_q4
 
-  !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (c = 0 ignores w).
-  pure subroutine mass_momentum_q4(s, p0, p1, cell, t, m, u, c, w, mass, q)
+  !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (c = 0 ignores w); with
+  !> `fill` also V_I += Σ N_Ip vol_p (the fill volumes).
+  pure subroutine mass_momentum_q4(s, p0, p1, cell, t, m, u, c, w, mass, q, fill, vol, vn)
     integer, intent(in) :: s                 !! nodes along x
     integer, intent(in) :: p0                !! first particle
     integer, intent(in) :: p1                !! last particle
@@ -89,6 +90,9 @@ contains
     real(wp), intent(in) :: w(2, *)          !! second particle vectors
     real(wp), intent(inout) :: mass(*)       !! nodal masses (accumulated)
     real(wp), intent(inout) :: q(2, *)       !! nodal vectors (accumulated)
+    logical, intent(in) :: fill              !! also the fill volumes
+    real(wp), intent(in) :: vol(*)           !! particle fill volumes (with `fill`)
+    real(wp), intent(inout) :: vn(*)         !! nodal fill volumes (with `fill`; accumulated)
     real(wp) :: N(4), mu(2)
     integer :: p
     integer(int64) :: I, J ! 64-bit: the neighbours' addresses are offsets of I's
@@ -104,6 +108,10 @@ contains
       mass(I + 1) = mass(I + 1) + N(2) * m(p); q(:, I + 1) = q(:, I + 1) + N(2) * mu
       mass(J) = mass(J) + N(3) * m(p);         q(:, J) = q(:, J) + N(3) * mu
       mass(J + 1) = mass(J + 1) + N(4) * m(p); q(:, J + 1) = q(:, J + 1) + N(4) * mu
+      if (fill) then
+        vn(I) = vn(I) + N(1) * vol(p); vn(I + 1) = vn(I + 1) + N(2) * vol(p)
+        vn(J) = vn(J) + N(3) * vol(p); vn(J + 1) = vn(J + 1) + N(4) * vol(p)
+      end if
     end do
   end subroutine mass_momentum_q4
 

@@ -110,8 +110,10 @@ contains
     end do
   end subroutine weighted_s27
 
-  !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (cw = 0 ignores w).
-  pure subroutine mass_momentum_s27(s, s2, h, p0, p1, cell, t, gimp, wg, m, u, cw, w, mass, q)
+  !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + cw w_p), one pass (cw = 0 ignores w); with
+  !> `fill` also V_I += Σ N_Ip vol_p (the fill volumes).
+  pure subroutine mass_momentum_s27(s, s2, h, p0, p1, cell, t, gimp, wg, m, u, cw, w, mass, q, &
+                               fill, vol, vn)
     integer, intent(in) :: s                 !! nodes along x
     integer, intent(in) :: s2                !! nodes per x-y plane
     real(wp), intent(in) :: h(3)             !! 1/h per direction
@@ -127,6 +129,9 @@ contains
     real(wp), intent(in) :: w(3, *)          !! second particle vectors
     real(wp), intent(inout) :: mass(*)       !! nodal masses (accumulated)
     real(wp), intent(inout) :: q(3, *)       !! nodal vectors (accumulated)
+    logical, intent(in) :: fill              !! also the fill volumes
+    real(wp), intent(in) :: vol(*)           !! particle fill volumes (with `fill`)
+    real(wp), intent(inout) :: vn(*)         !! nodal fill volumes (with `fill`; accumulated)
     real(wp) :: wf(3, 3), g(3, 3), mu(3), w23, nk
     integer :: p, a, b, c
     integer(int64) :: I
@@ -152,6 +157,7 @@ contains
             nk = wf(a, 1) * w23
             mass(I) = mass(I) + nk * m(p)
             q(:, I) = q(:, I) + nk * mu
+            if (fill) vn(I) = vn(I) + nk * vol(p)
             I = I + 1
           end do
         end do

@@ -108,8 +108,10 @@ contains
     end do
   end subroutine weighted_s9
 
-  !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (c = 0 ignores w).
-  pure subroutine mass_momentum_s9(s, h, p0, p1, cell, t, gimp, wg, m, u, c, w, mass, q)
+  !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (c = 0 ignores w); with
+  !> `fill` also V_I += Σ N_Ip vol_p (the fill volumes).
+  pure subroutine mass_momentum_s9(s, h, p0, p1, cell, t, gimp, wg, m, u, c, w, mass, q, &
+                              fill, vol, vn)
     integer, intent(in) :: s                 !! nodes along x
     real(wp), intent(in) :: h(2)             !! 1/h per direction
     integer, intent(in) :: p0                !! first particle
@@ -124,6 +126,9 @@ contains
     real(wp), intent(in) :: w(2, *)          !! second particle vectors
     real(wp), intent(inout) :: mass(*)       !! nodal masses (accumulated)
     real(wp), intent(inout) :: q(2, *)       !! nodal vectors (accumulated)
+    logical, intent(in) :: fill              !! also the fill volumes
+    real(wp), intent(in) :: vol(*)           !! particle fill volumes (with `fill`)
+    real(wp), intent(inout) :: vn(*)         !! nodal fill volumes (with `fill`; accumulated)
     real(wp) :: wx(3), gx(3), wy(3), gy(3), mu(2), nk
     integer :: p, a, b
     integer(int64) :: I
@@ -147,6 +152,7 @@ contains
           nk = wx(a) * wy(b)
           mass(I) = mass(I) + nk * m(p)
           q(:, I) = q(:, I) + nk * mu
+          if (fill) vn(I) = vn(I) + nk * vol(p)
           I = I + 1
         end do
       end do
