@@ -25,7 +25,7 @@ module empm_integrator
   implicit none
   private
   public :: empm_integrator_t, eval_basis, map_velocity, update_stress, initial_acceleration
-  public :: particle_axpy, drift_prepare, drift_begin, drift_end, WALL_SCHEMES
+  public :: drift_prepare, drift_begin, drift_end, WALL_SCHEMES
 
   !> Particles per material call in [[update_stress]]: their L, F, strain and stress fit in
   !> the L1 cache together.
@@ -359,25 +359,6 @@ contains
     self%basis_ready = .false.
   end subroutine integrator_resync
 
-  !> y_p += c a_p for particles 1..np (ndim rows).
-  subroutine particle_axpy(np, c, a, y)
-    integer, intent(in) :: np                      !! number of particles
-    real(wp), intent(in) :: c                      !! scale
-    real(wp), intent(in), contiguous :: a(:,:)     !! particle vectors (ndim, >= np)
-    real(wp), intent(inout), contiguous :: y(:,:)  !! particle vectors (ndim, >= np)
-    integer :: nc, ic, p0, p1, d
-    if (c == 0.0_wp) return
-    d = size(y, 1)
-    nc = empm_chunks(np)
-    !$omp parallel do default(none) schedule(static, 1) shared(np, nc, d, c, a, y) &
-    !$omp   private(p0, p1) if(nc > 1)
-    do ic = 0, nc - 1
-      call empm_chunk_bounds(np, nc, ic, p0, p1)
-      if (p1 >= p0) call axpy_flat(d * (p1 - p0 + 1), c, a(:, p0:p1), y(:, p0:p1))
-    end do
-    !$omp end parallel do
-  end subroutine particle_axpy
-
   !> The opening of every scheme's step, timed as its shape, P2G and grid phases: shape
   !> functions at the particles; mass and mass-weighted velocity v_p + c w_p on the grid in one
   !> pass (without `c` and `w`: the momentum); nodal velocity = that / mass with the Dirichlet
@@ -654,7 +635,7 @@ contains
   !> ([[drift_end]] forms the next correction from them) and move the particles by
   !> Δt G2P(v)_p. `v` is the grid velocity field whose interpolation moves the particles. With
   !> `cx` and `cv`, the particle updates x += cx a and (after the move) v += cv a of the scheme
-  !> are made in the same pass, as [[particle_axpy]] would make them (skipped when 0). One pass,
+  !> are made in the same pass (skipped when 0; [[axpy_flat]] on the block). One pass,
   !> block by block: each block's particle data is read once, its basis and nodes once.
   subroutine drift_begin(self, model, v, dt, cx, cv)
     class(empm_integrator_t), intent(inout) :: self  !! integrator (l0)
