@@ -58,7 +58,8 @@ contains
     nd = grid%ndim
     ! The lean 2D path needs uniform γ and valid parameters (a support larger than the storage
     ! falls back, and the general path reports it).
-    fast = nd == 2 .and. .not. allocated(self%gamma_node) .and. params_ok(self, grid)
+    fast = (nd == 2 .or. nd == 3) .and. .not. allocated(self%gamma_node) .and. &
+      params_ok(self, grid)
     hs = lme_h(grid)
     cut = -log(self%tol0)
     rmax = sqrt(cut / self%gamma) * hs
@@ -93,9 +94,15 @@ contains
         end if
       end if
       it = LME_FALLBACK
-      if (fast) call lme_point_2d(grid, pts%x(:, p), self%gamma, cut, hs, rmax, &
-        self%max_iter, lam, basis%maxn, basis%nn(p), basis%node(:, p), basis%N(:, p), &
-        basis%dN(:, :, p), it)
+      if (fast) then
+        if (nd == 2) then
+          call lme_point_2d(grid, pts%x(:, p), self%gamma, cut, hs, rmax, self%max_iter, lam, &
+            basis%maxn, basis%nn(p), basis%node(:, p), basis%N(:, p), basis%dN(:, :, p), it)
+        else
+          call lme_point_3d(grid, pts%x(:, p), self%gamma, cut, hs, rmax, self%max_iter, lam, &
+            basis%maxn, basis%nn(p), basis%node(:, p), basis%N(:, p), basis%dN(:, :, p), it)
+        end if
+      end if
       if (it == LME_FALLBACK) then
         ! Anything unusual: the guarded general path, from the same warm start. (The remedy is
         ! a separate call after a failure: the common call passes its arrays once.)
@@ -393,6 +400,276 @@ contains
       end if
       jinv(1) = b22 / det; jinv(2) = -b12 / det; jinv(3) = b11 / det
     end subroutine inverse_2d
+
+    !> The 3D twin of [[lme_point_2d]] (uniform γ, a warm start near λ*): the same passes and
+    !> early stop with 3-vectors, a 3×3 linear system for the final values, and the third
+    !> moments (ten entries) in a pass of their own once Newton has stopped. Every case [[lme_point_2d]] hands over (the
+    !> general path's guards, a support larger than the storage, x outside the candidates'
+    !> bounding box) returns `LME_FALLBACK` here as well.
+    pure subroutine lme_point_3d(grid, x, gamma, cut, h, rmax, maxit, lam, cap, nn, node, N, &
+                                 dN, iters)
+      type(empm_grid_t), intent(in) :: grid     !! background grid (3D)
+      real(wp), intent(in) :: x(3)              !! point
+      real(wp), intent(in) :: gamma             !! γ
+      real(wp), intent(in) :: cut               !! −ln tol0
+      real(wp), intent(in) :: h                 !! nodal spacing of γ [length]
+      real(wp), intent(in) :: rmax              !! support radius [length]
+      integer, intent(in) :: maxit              !! Newton iteration cap
+      real(wp), intent(inout) :: lam(3)         !! λ [1/length]: warm start in, λ* out
+      integer, intent(in) :: cap                !! storage per point
+      integer, intent(out) :: nn                !! number of supporting nodes
+      integer, intent(out) :: node(cap)         !! node indices
+      real(wp), intent(out) :: N(cap)           !! values
+      real(wp), intent(out) :: dN(3, cap)       !! gradients
+      integer, intent(out) :: iters             !! Newton iterations, or LME_FALLBACK
+      integer, parameter :: BOX_MAX = 64        ! as in lme_point_2d
+      real(wp) :: xr(BOX_MAX), xr2(BOX_MAX), s(3), rd(3), xi2, xi3, xi22, xi32, q, f, fmax
+      real(wp) :: qmax, x2max, xlo(3), xhi(3), l(3), c(3), sw, m1(3), m2(6), m3(10), logz
+      real(wp) :: r(3), jm(6), ji(6), scl, rn, d(3), dn2, slope, logz0, b(3), mm(3, 3)
+      real(wp) :: adj(3, 3), det, qv(3), st, t1(3), t2(6), rt(3), v(3), p, rem, wd, lim
+      integer :: lo(3), hi(3), i, j, k, id0, a, amax, it, i0, i1
+      logical :: guard, far
+      nn = 0
+      it = 0
+      iters = LME_FALLBACK ! until the very end, as in lme_point_2d
+      if (.not. grid%inside(x)) return
+      l = lam * h
+      if (.not. all(abs(l) <= LME_LAM_MAX)) return
+      do k = 1, 3
+        s(k) = (x(k) - grid%origin(k)) * grid%inv_h(k); rd(k) = rmax * grid%inv_h(k)
+        lo(k) = max(0, ceiling(s(k) - rd(k))); hi(k) = min(grid%ncell(k), floor(s(k) + rd(k)))
+      end do
+      if (hi(1) - lo(1) >= BOX_MAX) return
+      do i = lo(1), hi(1)
+        xr(i - lo(1) + 1) = (x(1) - (grid%origin(1) + i * grid%h(1))) / h
+        xr2(i - lo(1) + 1) = xr(i - lo(1) + 1)**2
+      end do
+      fmax = -huge(1.0_wp); amax = 0; qmax = 0.0_wp
+      xlo = huge(1.0_wp); xhi = -huge(1.0_wp)
+      lim = cut / gamma
+      ! Candidates with the expressions of lme_point, its rows trimmed the same way (the test
+      ! on q decides), so the same nodes in the same order; their exponents at once.
+      do k = lo(3), hi(3)
+        xi3 = (x(3) - (grid%origin(3) + k * grid%h(3))) / h
+        xi32 = xi3**2
+        do j = lo(2), hi(2)
+          xi2 = (x(2) - (grid%origin(2) + j * grid%h(2))) / h
+          xi22 = xi2**2
+          rem = lim - (xi22 + xi32)
+          if (rem < -1.0e-9_wp * lim) cycle
+          wd = sqrt(max(rem, 0.0_wp) + 1.0e-12_wp * lim) * h * grid%inv_h(1) + 1.0e-6_wp
+          i0 = max(lo(1), ceiling(s(1) - wd)); i1 = min(hi(1), floor(s(1) + wd))
+          id0 = grid%id0 + grid%ln(1) * (j + grid%ln(2) * k)
+          do i = i0, i1
+            q = gamma * ((xr2(i - lo(1) + 1) + xi22) + xi32)
+            if (q > cut) cycle
+            if (nn == cap) return
+            nn = nn + 1
+            node(nn) = id0 + i
+            dN(1, nn) = xr(i - lo(1) + 1); dN(2, nn) = xi2; dN(3, nn) = xi3
+            f = -q + ((l(1) * dN(1, nn) + l(2) * xi2) + l(3) * xi3)
+            N(nn) = f
+            if (f > fmax) then
+              fmax = f; amax = nn
+            end if
+            qmax = max(qmax, q)
+            xlo(1) = min(xlo(1), dN(1, nn)); xhi(1) = max(xhi(1), dN(1, nn))
+            xlo(2) = min(xlo(2), xi2); xhi(2) = max(xhi(2), xi2)
+            xlo(3) = min(xlo(3), xi3); xhi(3) = max(xhi(3), xi3)
+          end do
+        end do
+      end do
+      if (nn < 4) return
+      if (.not. all(xhi >= 0.0_wp .and. xlo <= 0.0_wp)) return
+      x2max = qmax / gamma
+      far = .false.
+      c = dN(:, amax)
+      call weights_3d(nn, fmax, c, dN, N, sw, m1, m2, logz, r, jm)
+      do
+        rn = sqrt(r(1)**2 + r(2)**2 + r(3)**2)
+        if (logz < -qmax - 1.0e-9_wp * (1.0_wp + qmax)) return
+        call inverse_3d(jm, ji, scl)
+        if (scl < LME_J_MIN) return
+        d(1) = -(ji(1) * r(1) + ji(2) * r(2) + ji(3) * r(3)) / scl
+        d(2) = -(ji(2) * r(1) + ji(4) * r(2) + ji(5) * r(3)) / scl
+        d(3) = -(ji(3) * r(1) + ji(5) * r(2) + ji(6) * r(3)) / scl
+        dn2 = d(1)**2 + d(2)**2 + d(3)**2
+        if (rn < LME_TOL_CONV) exit
+        if (.not. far .and. 0.5_wp * (sqrt(x2max) + rn)**3 * dn2 < LME_TOL_CONV) exit
+        if (it >= maxit .or. dn2 > LME_STEP_MAX**2) return
+        guard = rn > LME_TOL_GUARD
+        if (guard) then
+          slope = r(1) * d(1) + r(2) * d(2) + r(3) * d(3); logz0 = logz; far = .true.
+        end if
+        l = l + d
+        it = it + 1
+        if (.not. all(abs(l) <= LME_LAM_MAX)) return
+        fmax = -huge(1.0_wp); amax = 0
+        do a = 1, nn
+          f = -(gamma * ((dN(1, a)**2 + dN(2, a)**2) + dN(3, a)**2)) + &
+              ((l(1) * dN(1, a) + l(2) * dN(2, a)) + l(3) * dN(3, a))
+          N(a) = f
+          if (f > fmax) then
+            fmax = f; amax = a
+          end if
+        end do
+        c = dN(:, amax)
+        call weights_3d(nn, fmax, c, dN, N, sw, m1, m2, logz, r, jm)
+        if (guard) then
+          if (.not. (logz <= logz0 + LME_ARMIJO_C * slope)) return
+        end if
+      end do
+      ! Final values as in lme_point_2d: p̂ ∝ w (1 + q·u) with (S1 + S0 c) + (S2 + c⊗S1) q = 0,
+      ! here a 3×3 system solved by its adjugate; the moments of p̂ from S0..S3.
+      call third_3d(nn, c, dN, N, m3)
+      b = m1 + sw * c
+      mm(:, 1) = m2([1, 2, 3]) + c * m1(1)
+      mm(:, 2) = m2([2, 4, 5]) + c * m1(2)
+      mm(:, 3) = m2([3, 5, 6]) + c * m1(3)
+      adj(1, 1) = mm(2, 2) * mm(3, 3) - mm(2, 3) * mm(3, 2)
+      adj(1, 2) = mm(1, 3) * mm(3, 2) - mm(1, 2) * mm(3, 3)
+      adj(1, 3) = mm(1, 2) * mm(2, 3) - mm(1, 3) * mm(2, 2)
+      adj(2, 1) = mm(2, 3) * mm(3, 1) - mm(2, 1) * mm(3, 3)
+      adj(2, 2) = mm(1, 1) * mm(3, 3) - mm(1, 3) * mm(3, 1)
+      adj(2, 3) = mm(1, 3) * mm(2, 1) - mm(1, 1) * mm(2, 3)
+      adj(3, 1) = mm(2, 1) * mm(3, 2) - mm(2, 2) * mm(3, 1)
+      adj(3, 2) = mm(1, 2) * mm(3, 1) - mm(1, 1) * mm(3, 2)
+      adj(3, 3) = mm(1, 1) * mm(2, 2) - mm(1, 2) * mm(2, 1)
+      det = mm(1, 1) * adj(1, 1) + mm(1, 2) * adj(2, 1) + mm(1, 3) * adj(3, 1)
+      if (.not. (abs(det) > LME_J_MIN * sw**3)) return
+      do i = 1, 3
+        qv(i) = -(adj(i, 1) * b(1) + adj(i, 2) * b(2) + adj(i, 3) * b(3)) / det
+      end do
+      if (sqrt(qv(1)**2 + qv(2)**2 + qv(3)**2) * (sqrt(x2max) + sqrt(c(1)**2 + c(2)**2 + &
+          c(3)**2)) > 0.5_wp) return
+      st = sw + (m1(1) * qv(1) + m1(2) * qv(2) + m1(3) * qv(3))
+      t1(1) = m1(1) + (m2(1) * qv(1) + m2(2) * qv(2) + m2(3) * qv(3))
+      t1(2) = m1(2) + (m2(2) * qv(1) + m2(4) * qv(2) + m2(5) * qv(3))
+      t1(3) = m1(3) + (m2(3) * qv(1) + m2(5) * qv(2) + m2(6) * qv(3))
+      t2(1) = m2(1) + (m3(1) * qv(1) + m3(2) * qv(2) + m3(3) * qv(3))
+      t2(2) = m2(2) + (m3(2) * qv(1) + m3(4) * qv(2) + m3(5) * qv(3))
+      t2(3) = m2(3) + (m3(3) * qv(1) + m3(5) * qv(2) + m3(6) * qv(3))
+      t2(4) = m2(4) + (m3(4) * qv(1) + m3(7) * qv(2) + m3(8) * qv(3))
+      t2(5) = m2(5) + (m3(5) * qv(1) + m3(8) * qv(2) + m3(9) * qv(3))
+      t2(6) = m2(6) + (m3(6) * qv(1) + m3(9) * qv(2) + m3(10) * qv(3))
+      rt = t1 / st
+      jm(1) = t2(1) / st - rt(1) * rt(1)
+      jm(2) = t2(2) / st - rt(1) * rt(2)
+      jm(3) = t2(3) / st - rt(1) * rt(3)
+      jm(4) = t2(4) / st - rt(2) * rt(2)
+      jm(5) = t2(5) / st - rt(2) * rt(3)
+      jm(6) = t2(6) / st - rt(3) * rt(3)
+      call inverse_3d(jm, ji, scl)
+      if (scl < LME_J_MIN) return
+      ji = ji / scl
+      ! r̂ − c = rt; ∇p̂_a = −p̂_a Ĵ⁻¹ (ξ_a − r̂)/h.
+      do a = 1, nn
+        v(1) = dN(1, a) - c(1); v(2) = dN(2, a) - c(2); v(3) = dN(3, a) - c(3)
+        p = N(a) * (1.0_wp + (qv(1) * v(1) + qv(2) * v(2) + qv(3) * v(3))) / st
+        N(a) = p
+        v = v - rt
+        dN(1, a) = -p * (ji(1) * v(1) + ji(2) * v(2) + ji(3) * v(3)) / h
+        dN(2, a) = -p * (ji(2) * v(1) + ji(4) * v(2) + ji(5) * v(3)) / h
+        dN(3, a) = -p * (ji(3) * v(1) + ji(5) * v(2) + ji(6) * v(3)) / h
+      end do
+      if (far) then
+        lam = l / h
+      else
+        lam = (l + d) / h
+      end if
+      iters = it
+    end subroutine lme_point_3d
+
+    !> 3D weights w_a = exp(f_a − fm) (f in `w` on entry) and their moments about c up to
+    !> second order (S2 as (11, 12, 13, 22, 23, 33)), and log Z, r and J (as S2) of the
+    !> normalised weights. The third moments, needed once, are [[third_3d]]'s.
+    pure subroutine weights_3d(nn, fm, c, xi, w, sw, m1, m2, logz, r, jm)
+      integer, intent(in) :: nn            !! number of nodes
+      real(wp), intent(in) :: fm           !! max f
+      real(wp), intent(in) :: c(3)         !! centre of the moments
+      real(wp), intent(in) :: xi(3, *)     !! ξ_a
+      real(wp), intent(inout) :: w(*)      !! in: f_a; out: w_a
+      real(wp), intent(out) :: sw          !! S0
+      real(wp), intent(out) :: m1(3)       !! S1
+      real(wp), intent(out) :: m2(6)       !! S2
+      real(wp), intent(out) :: logz        !! log Z
+      real(wp), intent(out) :: r(3)        !! r = Σ p ξ
+      real(wp), intent(out) :: jm(6)       !! J
+      real(wp) :: e, u1, u2, u3, e1, e2, e3, g(3)
+      integer :: b
+      ! The exponentials in a loop of their own (vectorised): a call inside the summing loop
+      ! would spill its accumulators (the SSE registers are caller-saved).
+      do b = 1, nn
+        w(b) = exp(w(b) - fm)
+      end do
+      sw = 0.0_wp; m1 = 0.0_wp; m2 = 0.0_wp
+      do b = 1, nn
+        e = w(b)
+        u1 = xi(1, b) - c(1); u2 = xi(2, b) - c(2); u3 = xi(3, b) - c(3)
+        e1 = e * u1; e2 = e * u2; e3 = e * u3
+        sw = sw + e
+        m1(1) = m1(1) + e1; m1(2) = m1(2) + e2; m1(3) = m1(3) + e3
+        m2(1) = m2(1) + e1 * u1; m2(2) = m2(2) + e1 * u2; m2(3) = m2(3) + e1 * u3
+        m2(4) = m2(4) + e2 * u2; m2(5) = m2(5) + e2 * u3; m2(6) = m2(6) + e3 * u3
+      end do
+      logz = fm + log(sw)
+      g = m1 / sw
+      r = c + g
+      jm(1) = m2(1) / sw - g(1) * g(1); jm(2) = m2(2) / sw - g(1) * g(2)
+      jm(3) = m2(3) / sw - g(1) * g(3); jm(4) = m2(4) / sw - g(2) * g(2)
+      jm(5) = m2(5) / sw - g(2) * g(3); jm(6) = m2(6) / sw - g(3) * g(3)
+    end subroutine weights_3d
+
+    !> Third moments S3 = Σ w u⊗u⊗u about c, u = ξ − c, as (111, 112, 113, 122, 123, 133, 222,
+    !> 223, 233, 333): a pass of their own after Newton, since the ten sums spill when every
+    !> weight pass carries them (unlike 2D's four).
+    pure subroutine third_3d(nn, c, xi, w, m3)
+      integer, intent(in) :: nn            !! number of nodes
+      real(wp), intent(in) :: c(3)         !! centre of the moments
+      real(wp), intent(in) :: xi(3, *)     !! ξ_a
+      real(wp), intent(in) :: w(*)         !! w_a
+      real(wp), intent(out) :: m3(10)      !! S3
+      real(wp) :: u1, u2, u3, e11, e12, e13, e22, e23, e33
+      integer :: b
+      m3 = 0.0_wp
+      do b = 1, nn
+        u1 = xi(1, b) - c(1); u2 = xi(2, b) - c(2); u3 = xi(3, b) - c(3)
+        e11 = (w(b) * u1) * u1; e12 = (w(b) * u1) * u2; e13 = (w(b) * u1) * u3
+        e22 = (w(b) * u2) * u2; e23 = (w(b) * u2) * u3; e33 = (w(b) * u3) * u3
+        m3(1) = m3(1) + e11 * u1; m3(2) = m3(2) + e11 * u2; m3(3) = m3(3) + e11 * u3
+        m3(4) = m3(4) + e12 * u2; m3(5) = m3(5) + e12 * u3; m3(6) = m3(6) + e13 * u3
+        m3(7) = m3(7) + e22 * u2; m3(8) = m3(8) + e22 * u3; m3(9) = m3(9) + e23 * u3
+        m3(10) = m3(10) + e33 * u3
+      end do
+    end subroutine third_3d
+
+    !> (J/‖J‖_F)⁻¹ of a symmetric 3×3 J = (11, 12, 13, 22, 23, 33) by its adjugate, and ‖J‖_F;
+    !> `nrm` = 0 when J is not positive definite to within the Frobenius condition
+    !> LME_COND_MAX (the test of the general path's `sym_inverse`).
+    pure subroutine inverse_3d(jj, jinv, nrm)
+      real(wp), intent(in) :: jj(6)        !! J
+      real(wp), intent(out) :: jinv(6)     !! (J/‖J‖)⁻¹
+      real(wp), intent(out) :: nrm         !! ‖J‖_F, or 0 on failure
+      real(wp) :: bb(6), ad(6), det, nadj
+      nrm = sqrt(jj(1)**2 + jj(4)**2 + jj(6)**2 + 2.0_wp * (jj(2)**2 + jj(3)**2 + jj(5)**2))
+      jinv = 0.0_wp
+      if (.not. (nrm > sqrt(SUMSQ_LO) .and. nrm < sqrt(SUMSQ_HI))) then
+        nrm = 0.0_wp; return
+      end if
+      bb = jj / nrm
+      ad(1) = bb(4) * bb(6) - bb(5) * bb(5)
+      ad(2) = bb(3) * bb(5) - bb(2) * bb(6)
+      ad(3) = bb(2) * bb(5) - bb(3) * bb(4)
+      ad(4) = bb(1) * bb(6) - bb(3) * bb(3)
+      ad(5) = bb(2) * bb(3) - bb(1) * bb(5)
+      ad(6) = bb(1) * bb(4) - bb(2) * bb(2)
+      det = bb(1) * ad(1) + bb(2) * ad(2) + bb(3) * ad(3)
+      nadj = sqrt(ad(1)**2 + ad(4)**2 + ad(6)**2 + 2.0_wp * (ad(2)**2 + ad(3)**2 + ad(5)**2))
+      if (.not. (det > 0.0_wp .and. det * LME_COND_MAX > nadj)) then
+        nrm = 0.0_wp; return
+      end if
+      jinv = ad / det
+    end subroutine inverse_3d
   end subroutine lme_batch
 
   !> [[lme_point]] from the caller's warm start and, if that fails for a reason other than the
