@@ -22,7 +22,7 @@
 !> |r| > `LME_TOL_GUARD`, full steps after (backtracking all the way stalls on round-off).
 !> Converged when |r| < `LME_TOL_CONV`, i.e. ‖r_phys‖/h < 1e-10, or (3D with uniform γ, after
 !> no guarded step) when a bound proves the residual after the final linearised step below it,
-!> as in the 2D batch path. The moments r and J are
+!> as in the batch's lean paths. The moments r and J are
 !> accumulated about ξ of the heaviest node, so that J has no cancellation when one node carries
 !> nearly all the weight (large γ far from λ*, where J is tiny but well conditioned).
 !>
@@ -39,10 +39,11 @@
 !> problems' multipliers, built by `configure`; docs/shape-functions.md, "Warm starts of moving
 !> particles").
 !>
-!> **2D batch path.** `eval_batch` in 2D with uniform γ uses `lme_point_2d`: the same
-!> algorithm in three passes over the support, stopping Newton early when a bound proves the
-!> residual after the final step below the tolerance, with values made exactly consistent by a
-!> 2×2 solve (docs/shape-functions.md, "The 2D batch path"); anything unusual falls back to the
+!> **Lean batch paths.** `eval_batch` in 2D and 3D with uniform γ uses `lme_point_2d` and
+!> `lme_point_3d`: the same algorithm in three passes over the support (3D: a fourth for its
+!> third moments), stopping Newton early when a bound proves the residual after the final step
+!> below the tolerance, with values made exactly consistent by a 2×2 or 3×3 solve
+!> (docs/shape-functions.md, "The lean batch paths"); anything unusual falls back to the
 !> general path above.
 !>
 !> **Gradient.** With uniform γ: ∇p_a = −p_a J⁻¹ (ξ_a − r)/h, which equals −p_a J⁻¹ l_a at the
@@ -96,10 +97,10 @@
 !> **Files.** This module holds the type, the constants and the interfaces; the procedures are
 !> in its submodules, one file each: `empm_shape_lme_setup` (parameters, `configure`, name,
 !> storage bound, node-wise γ), `empm_shape_lme_batch` (`eval_point`, `eval_batch` with the
-!> lean 2D path, and the remedy), `empm_shape_lme_newton` (the general path: candidates, the
+!> lean 2D and 3D paths, and the remedy), `empm_shape_lme_newton` (the general path: candidates, the
 !> guarded Newton kernel, the parameter helpers) and its child `empm_shape_lme_hull` (the hull
 !> tests of the failure path, which share the kernel's small linear algebra). Procedures that
-!> call each other per particle are kept in one file, and the 2D path's kernels are internal
+!> call each other per particle are kept in one file, and the lean paths' kernels are internal
 !> procedures of the batch routine: gfortran gives submodule procedures external linkage, and
 !> in the position-independent library GCC then assumes they may be interposed, so it neither
 !> inlines nor specialises calls to them, even from their own file.
@@ -132,7 +133,8 @@ module empm_shape_lme
   integer, parameter :: LME_MAXIT_DEFAULT = 100     !! default Newton iteration cap
   !> Range of a sum of squares in which sqrt(sum) is accurate (no under- or overflow).
   real(wp), parameter :: SUMSQ_LO = 1.0e-280_wp, SUMSQ_HI = 1.0e280_wp
-  !> Iteration count returned by `lme_point_2d` when the general path must take over.
+  !> Iteration count returned by `lme_point_2d` and `lme_point_3d` when the general path must
+  !> take over.
   integer, parameter :: LME_FALLBACK = -1
   !> Intervals of a cell in the warm-start table (`start_tab`).
   integer, parameter :: LME_START_N = 512

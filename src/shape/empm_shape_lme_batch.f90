@@ -1,11 +1,11 @@
 !> LME evaluation entry points: one point (`eval_point`), every particle (`eval_batch`: the
-!> particle-parallel loop with the extrapolated warm start and the lean 2D path) and the
-!> 'enlarge' remedy around the general path.
+!> particle-parallel loop with the extrapolated warm start and the lean 2D and 3D paths) and
+!> the 'enlarge' remedy around the general path.
 !>
-!> The lean 2D path (`lme_point_2d`, with its fused weight-and-moment pass `weights_2d` and 2×2
-!> inverse `inverse_2d`) is made of internal procedures of the batch routine: local to this
-!> file, so the compiler inlines `lme_point_2d` into the particle loop and calls the others
-!> directly, as it did when LME was one module. (Submodule procedures have external linkage;
+!> The lean paths (`lme_point_2d` and `lme_point_3d`, with their fused weight-and-moment passes
+!> `weights_2d` and `weights_3d` and small inverses) are made of internal procedures of the
+!> batch routine: local to this file, so the compiler inlines them into the particle loop and
+!> calls the others directly, as it did when LME was one module. (Submodule procedures have external linkage;
 !> in the position-independent library that blocks inlining and specialisation.)
 submodule (empm_shape_lme) empm_shape_lme_batch
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES
@@ -56,8 +56,8 @@ contains
     call shape_batch_fits(pts%np, basis, ibad, info)
     if (info /= SHAPE_OK) return
     nd = grid%ndim
-    ! The lean 2D path needs uniform γ and valid parameters (a support larger than the storage
-    ! falls back, and the general path reports it).
+    ! The lean paths need 2D or 3D, uniform γ and valid parameters (a support larger than the
+    ! storage falls back, and the general path reports it).
     fast = (nd == 2 .or. nd == 3) .and. .not. allocated(self%gamma_node) .and. &
       params_ok(self, grid)
     hs = lme_h(grid)
@@ -173,7 +173,7 @@ contains
     !> third order (about the heaviest node), one writes values and gradients. Newton stops as
     !> soon as a bound proves the residual after the final linearised step below the tolerance;
     !> the moments of the final values follow from the third moments without another pass over
-    !> the nodes (docs/shape-functions.md, "The 2D batch path"). Only full Newton steps are
+    !> the nodes (docs/shape-functions.md, "The lean batch paths"). Only full Newton steps are
     !> taken here: whenever the general path could do something else (point outside the grid,
     !> ‖r‖ above the Armijo threshold, ill-conditioned J, a step or λ beyond its cap, the
     !> iteration cap, too few candidates or x outside their bounding box), `iters` returns

@@ -8,7 +8,7 @@ submodule (empm_shape_lme) empm_shape_lme_newton
                         SHAPE_OUTSIDE_HULL, SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES
   implicit none
 
-  !> Smallest Armijo step fraction (the constant is LME_ARMIJO_C, shared with the 2D batch path).
+  !> Smallest Armijo step fraction (the constant is LME_ARMIJO_C, shared with the batch's lean paths).
   real(wp), parameter :: ARMIJO_TMIN = 1.0e-12_wp
   !> Most candidates for the direct hull test on failure (C(40, 4) = 91390 simplices in 3D).
   integer, parameter :: HULL_TEST_MAXN = 40
@@ -160,7 +160,7 @@ contains
     varying = present(gnode) .and. present(node)
     fast2d = nd == 2 .and. .not. varying
     fast3d = nd == 3 .and. .not. varying
-    ! 3D with uniform γ stops as the lean 2D path does, on a bound of the residual after the
+    ! 3D with uniform γ stops as the lean paths do, on a bound of the residual after the
     ! final linearised step (1D keeps the test on ‖r‖ alone: its verification results rest on it).
     early = nd == 3 .and. .not. varying
     far = .false.
@@ -315,7 +315,7 @@ contains
         del = matvec(nd, jinv, r)
         dnorm = norm_small(nd, del)
         ! Done when r(λ + Δ), bounded by ½(ξmax + ‖r‖)³|Δ|², is within the tolerance: the final
-        ! step below is that Δ, linearised (docs/shape-functions.md, "The 2D batch path"); after
+        ! step below is that Δ, linearised (docs/shape-functions.md, "The lean batch paths"); after
         ! a far start (a guarded step) only on ‖r‖, as in 2D.
         if (early .and. .not. far) then
           if (0.5_wp * (ximax + rn)**3 * (dnorm / scl)**2 < LME_TOL_CONV) exit
