@@ -31,9 +31,10 @@ module empm_transfer
                         BASIS_G27
   use empm_nodes, only: empm_nodes_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
-  use empm_transfer_2d, only: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, &
-                              g2p_2d, gradient_g2p_2d
-  use empm_transfer_3d, only: internal_force_3d, velocity_gradient_3d, g2p_3d, gradient_g2p_3d
+  use empm_transfer_2d, only: weighted_2d, mass_momentum_2d, internal_force_2d, &
+                              velocity_gradient_2d, g2p_2d, gradient_g2p_2d
+  use empm_transfer_3d, only: weighted_3d, mass_momentum_3d, internal_force_3d, &
+                              velocity_gradient_3d, g2p_3d, gradient_g2p_3d
   use empm_transfer_q4, only: mass_q4, weighted_q4, mass_momentum_q4, body_force_q4, &
                               internal_force_q4, velocity_gradient_q4, g2p_q4, gradient_g2p_q4
   use empm_transfer_s9, only: mass_s9, weighted_s9, mass_momentum_s9, body_force_s9, &
@@ -440,12 +441,12 @@ contains
   pure subroutine weighted_range(basis, m, u, c, w, p0, p1, q)
     type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
     real(wp), intent(in) :: m(:)                     !! particle masses
-    real(wp), intent(in) :: u(:,:)                   !! particle vectors (ndim, np)
+    real(wp), intent(in), contiguous :: u(:,:)       !! particle vectors (ndim, np)
     real(wp), intent(in) :: c                        !! scale of `w` (0 to ignore it)
-    real(wp), intent(in) :: w(:,:)                   !! second particle vectors (ndim, np)
+    real(wp), intent(in), contiguous :: w(:,:)       !! second particle vectors (ndim, np)
     integer, intent(in) :: p0                        !! first particle
     integer, intent(in) :: p1                        !! last particle
-    real(wp), intent(inout) :: q(:,:)                !! nodal vectors (ndim, nnode), accumulated
+    real(wp), intent(inout), contiguous :: q(:,:)    !! nodal vectors (ndim, nnode), accumulated
     real(wp) :: mu(3)
     integer :: p, k, I, d
     if (basis%layout == BASIS_Q4) then
@@ -460,6 +461,12 @@ contains
       call weighted_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
                         basis%layout == BASIS_G27, basis%wg, m, u, c, w, q)
       return
+    end if
+    if (basis%ndim == 2) then
+      call weighted_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, m, u, c, w, q); return
+    end if
+    if (basis%ndim == 3) then
+      call weighted_3d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, m, u, c, w, q); return
     end if
     d = size(u, 1)
     do p = p0, p1
@@ -502,6 +509,9 @@ contains
                              basis%layout == BASIS_G27, basis%wg, m, u, c, w, mass, q, fill, vol, vn)
     else if (basis%ndim == 2) then
       call mass_momentum_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, m, u, c, w, &
+                            mass, q, fill, vol, vn)
+    else if (basis%ndim == 3) then
+      call mass_momentum_3d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, m, u, c, w, &
                             mass, q, fill, vol, vn)
     else
       call mass_range(basis, m, p0, p1, mass)

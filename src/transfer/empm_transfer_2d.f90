@@ -13,10 +13,38 @@ module empm_transfer_2d
   use empm_kinds, only: wp
   implicit none
   private
-  public :: mass_momentum_2d, internal_force_2d, velocity_gradient_2d, g2p_2d, &
+  public :: weighted_2d, mass_momentum_2d, internal_force_2d, velocity_gradient_2d, g2p_2d, &
             gradient_g2p_2d
 
 contains
+
+  !> q_I += Σ N_Ip m_p (u_p + c w_p) (c = 0 ignores w).
+  pure subroutine weighted_2d(mx, p0, p1, nn, node, N, m, u, c, w, q)
+    integer, intent(in) :: mx                !! basis capacity (nodes per particle)
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: N(mx, *)         !! shape-function values
+    real(wp), intent(in) :: m(*)             !! particle masses
+    real(wp), intent(in) :: u(2, *)          !! particle vectors
+    real(wp), intent(in) :: c                !! scale of `w`
+    real(wp), intent(in) :: w(2, *)          !! second particle vectors
+    real(wp), intent(inout) :: q(2, *)       !! nodal vectors (accumulated)
+    real(wp) :: mu(2)
+    integer :: p, k, I
+    do p = p0, p1
+      if (c == 0.0_wp) then
+        mu = m(p) * u(:, p)
+      else
+        mu = m(p) * (u(:, p) + c * w(:, p))
+      end if
+      do k = 1, nn(p)
+        I = node(k, p)
+        q(:, I) = q(:, I) + N(k, p) * mu
+      end do
+    end do
+  end subroutine weighted_2d
 
   !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (c = 0 ignores w); with
   !> `fill` also V_I += Σ N_Ip vol_p (the fill volumes).

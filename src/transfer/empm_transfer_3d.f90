@@ -11,10 +11,73 @@ module empm_transfer_3d
   use empm_kinds, only: wp
   implicit none
   private
-  public :: internal_force_3d, velocity_gradient_3d, g2p_3d, &
+  public :: weighted_3d, mass_momentum_3d, internal_force_3d, velocity_gradient_3d, g2p_3d, &
             gradient_g2p_3d
 
 contains
+
+  !> q_I += Σ N_Ip m_p (u_p + c w_p) (c = 0 ignores w).
+  pure subroutine weighted_3d(mx, p0, p1, nn, node, N, m, u, c, w, q)
+    integer, intent(in) :: mx                !! basis capacity (nodes per particle)
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: N(mx, *)         !! shape-function values
+    real(wp), intent(in) :: m(*)             !! particle masses
+    real(wp), intent(in) :: u(3, *)          !! particle vectors
+    real(wp), intent(in) :: c                !! scale of `w`
+    real(wp), intent(in) :: w(3, *)          !! second particle vectors
+    real(wp), intent(inout) :: q(3, *)       !! nodal vectors (accumulated)
+    real(wp) :: mu(3)
+    integer :: p, k, I
+    do p = p0, p1
+      if (c == 0.0_wp) then
+        mu = m(p) * u(:, p)
+      else
+        mu = m(p) * (u(:, p) + c * w(:, p))
+      end if
+      do k = 1, nn(p)
+        I = node(k, p)
+        q(:, I) = q(:, I) + N(k, p) * mu
+      end do
+    end do
+  end subroutine weighted_3d
+
+  !> m_I += Σ N_Ip m_p and q_I += Σ N_Ip m_p (u_p + c w_p), one pass (c = 0 ignores w); with
+  !> `fill` also V_I += Σ N_Ip vol_p (the fill volumes).
+  pure subroutine mass_momentum_3d(mx, p0, p1, nn, node, N, m, u, c, w, mass, q, fill, vol, vn)
+    integer, intent(in) :: mx                !! basis capacity (nodes per particle)
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    integer, intent(in) :: nn(*)             !! nodes per particle
+    integer, intent(in) :: node(mx, *)       !! node indices
+    real(wp), intent(in) :: N(mx, *)         !! shape-function values
+    real(wp), intent(in) :: m(*)             !! particle masses
+    real(wp), intent(in) :: u(3, *)          !! particle vectors
+    real(wp), intent(in) :: c                !! scale of `w`
+    real(wp), intent(in) :: w(3, *)          !! second particle vectors
+    real(wp), intent(inout) :: mass(*)       !! nodal masses (accumulated)
+    real(wp), intent(inout) :: q(3, *)       !! nodal vectors (accumulated)
+    logical, intent(in) :: fill              !! also the fill volumes
+    real(wp), intent(in) :: vol(*)           !! particle fill volumes (with `fill`)
+    real(wp), intent(inout) :: vn(*)         !! nodal fill volumes (with `fill`; accumulated)
+    real(wp) :: mu(3), nk
+    integer :: p, k, I
+    do p = p0, p1
+      if (c == 0.0_wp) then
+        mu = m(p) * u(:, p)
+      else
+        mu = m(p) * (u(:, p) + c * w(:, p))
+      end if
+      do k = 1, nn(p)
+        I = node(k, p); nk = N(k, p)
+        mass(I) = mass(I) + nk * m(p)
+        q(:, I) = q(:, I) + nk * mu
+        if (fill) vn(I) = vn(I) + nk * vol(p)
+      end do
+    end do
+  end subroutine mass_momentum_3d
 
   !> f_I −= Σ V_p σ_p ∇N_Ip (σ in Voigt order: xx, yy, zz, yz, xz, xy).
   pure subroutine internal_force_3d(mx, p0, p1, nn, node, dN, vol, stress, f)
