@@ -146,6 +146,26 @@ contains
       end if
       return
     end if
+    if (grid%ndim == 3 .and. basis%ndim == 3 .and. basis%maxn >= 8) then
+      ! 3D: one trilinear kernel call per chunk of particles.
+      nc = empm_chunks(pts%np)
+      ibad = huge(1)
+      !$omp parallel do default(none) num_threads(nc) schedule(static, 1) &
+      !$omp   shared(nc, grid, pts, basis) private(p0, p1, b) reduction(min: ibad) if(nc > 1)
+      do c = 0, nc - 1
+        call empm_chunk_bounds(pts%np, nc, c, p0, p1)
+        call linear_range_3d(grid, p0, p1, pts%x, basis%maxn, basis%nn, basis%node, basis%N, &
+                             basis%dN, b)
+        ibad = min(ibad, b)
+      end do
+      !$omp end parallel do
+      if (ibad == huge(1)) then
+        ibad = 0
+      else
+        info = SHAPE_OUTSIDE_GRID
+      end if
+      return
+    end if
     ! Particles are independent: threads share them; the first failure (lowest index) is kept.
     ibad = huge(1)
     !$omp parallel do default(none) schedule(static) shared(grid, pts, basis, ibad, info) &
@@ -238,6 +258,64 @@ contains
                             dN(1:2, 1:4, p))
     end do
   end subroutine linear_range_2d
+
+  !> Trilinear values and gradients at particles p0..p1 into node lists: the bits of
+  !> [[shape_linear_kernel]] (its cell, clamps and the products of [[shape_tp_assemble]], in
+  !> its node order, x fastest) without the per-point work arrays and run-time dimension. A
+  !> particle outside the closed grid box gets nn = 0; `ibad` is the first one, huge(1) if
+  !> none.
+  pure subroutine linear_range_3d(grid, p0, p1, x, mx, nn, node, N, dN, ibad)
+    type(empm_grid_t), intent(in) :: grid    !! background grid (3D)
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    real(wp), intent(in) :: x(3, *)          !! particle positions
+    integer, intent(in) :: mx                !! basis capacity (>= 8)
+    integer, intent(inout) :: nn(*)          !! nodes per particle
+    integer, intent(inout) :: node(mx, *)    !! node indices
+    real(wp), intent(inout) :: N(mx, *)      !! values
+    real(wp), intent(inout) :: dN(3, mx, *)  !! gradients
+    integer, intent(out) :: ibad             !! first particle outside the grid, huge(1) if none
+    real(wp) :: w(2, 3), g(2, 3), e(3), s, t, w23
+    integer :: p, d, i0(3), k1, k2, k3, a, row, n1, n12
+    n1 = grid%ln(1); n12 = grid%ln(1) * grid%ln(2)
+    do d = 1, 3
+      e(d) = grid%origin(d) + grid%ncell(d) * grid%h(d) ! grid%inside's upper faces
+      g(1, d) = -grid%inv_h(d); g(2, d) = grid%inv_h(d)
+    end do
+    ibad = huge(1)
+    do p = p0, p1
+      if (.not. (x(1, p) >= grid%origin(1) .and. x(1, p) <= e(1) .and. &
+                 x(2, p) >= grid%origin(2) .and. x(2, p) <= e(2) .and. &
+                 x(3, p) >= grid%origin(3) .and. x(3, p) <= e(3))) then
+        nn(p) = 0
+        ibad = min(ibad, p)
+        cycle
+      end if
+      do d = 1, 3
+        s = (x(d, p) - grid%origin(d)) * grid%inv_h(d)
+        i0(d) = min(max(floor(s), 0), grid%ncell(d) - 1)
+        t = min(max(s - i0(d), 0.0_wp), 1.0_wp)
+        w(1, d) = 1.0_wp - t
+        w(2, d) = t
+      end do
+      a = 0
+      do k3 = 1, 2
+        do k2 = 1, 2
+          w23 = w(k2, 2) * w(k3, 3)
+          row = grid%id0 + i0(1) + n1 * (i0(2) + k2 - 1) + n12 * (i0(3) + k3 - 1)
+          do k1 = 1, 2
+            a = a + 1
+            node(a, p) = row + k1 - 1
+            N(a, p) = w(k1, 1) * w23
+            dN(1, a, p) = g(k1, 1) * w23
+            dN(2, a, p) = g(k2, 2) * (w(k1, 1) * w(k3, 3))
+            dN(3, a, p) = g(k3, 3) * (w(k1, 1) * w(k2, 2))
+          end do
+        end do
+      end do
+      nn(p) = 8
+    end do
+  end subroutine linear_range_3d
 
   !> The compact bilinear basis (BASIS_Q4) at particles p0..p1: the lowest node of the cell
   !> and the local coordinates (also how [[linear_range_2d]] locates a particle, so both
