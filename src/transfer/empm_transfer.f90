@@ -20,10 +20,10 @@
 !> Every kernel dispatches on the basis layout and dimension once per particle chunk: the
 !> compact bilinear layout (`BASIS_Q4`) goes to [[empm_transfer_q4]], the compact 3^ndim
 !> stencils of quadratic B-splines and uGIMP to [[empm_transfer_s9]] (`BASIS_B9`, `BASIS_G9`:
-!> 2D) and [[empm_transfer_s27]] (`BASIS_B27`, `BASIS_G27`: 3D); node lists in 2D to the
-!> specialised loops of [[empm_transfer_2d]] for the kernels of the time step (mass +
-!> momentum, internal force, G2P, velocity gradient); everything else to the generic loops
-!> here. All paths do the same arithmetic in the same order (same bits). Nodal and particle
+!> 2D) and [[empm_transfer_s27]] (`BASIS_B27`, `BASIS_G27`: 3D); node lists in 2D and 3D to
+!> the specialised loops of [[empm_transfer_2d]] and [[empm_transfer_3d]] for the kernels of
+!> the time step (momentum, mass + momentum, internal force, G2P, velocity gradient);
+!> everything else (1D, the mass alone, body forces) to the generic loops here. All paths do the same arithmetic in the same order (same bits). Nodal and particle
 !> arrays must be contiguous.
 module empm_transfer
   use empm_kinds, only: wp
