@@ -361,10 +361,14 @@ contains
       real(wp), intent(out) :: jm(3)       !! J
       real(wp) :: e, u1, u2, eu1, eu2
       integer :: b
+      ! The exponentials in a loop of their own, as in weights_3d: the vector exp call inside
+      ! the summing loop made its ten accumulators spill around every pair of nodes.
+      do b = 1, nn
+        w(b) = exp(w(b) - fm)
+      end do
       sw = 0.0_wp; m1 = 0.0_wp; m2 = 0.0_wp; m3 = 0.0_wp
       do b = 1, nn
-        e = exp(w(b) - fm)
-        w(b) = e
+        e = w(b)
         u1 = xi(1, b) - c1; u2 = xi(2, b) - c2
         eu1 = e * u1; eu2 = e * u2
         sw = sw + e
