@@ -14,6 +14,11 @@ submodule (empm_shape_lme) empm_shape_lme_batch
   use empm_shape_linear, only: shape_batch_fits, shape_keep_first_failure
   implicit none
 
+  !> Most candidates of the lean paths, whose γ|ξ_a|² they keep on the stack for the Newton
+  !> steps' exponents: never reached in 2D (the box of at most 64 columns holds fewer), γ
+  !> below about 0.14 in 3D (then the general path takes the point).
+  integer, parameter :: LEAN_MAX = 4096
+
 contains
 
   module procedure lme_eval_point
@@ -203,6 +208,7 @@ contains
       ! path).
       integer, parameter :: BOX_MAX = 64
       real(wp) :: xr(BOX_MAX), xr2(BOX_MAX)
+      real(wp) :: qa(LEAN_MAX) ! γ|ξ_a|² of each candidate (the value the Newton steps need)
       integer :: lo1, hi1, lo2, hi2, i, j, id0, a, amax, it
       logical :: guard, far
       nn = 0
@@ -235,8 +241,9 @@ contains
           xi1 = xr(i - lo1 + 1)
           q = gamma * (xr2(i - lo1 + 1) + xi22)
           if (q > cut) cycle
-          if (nn == cap) return
+          if (nn == cap .or. nn == LEAN_MAX) return
           nn = nn + 1
+          qa(nn) = q
           node(nn) = id0 + i
           dN(1, nn) = xi1; dN(2, nn) = xi2
           f = -q + (l1 * xi1 + l2 * xi2)
@@ -284,7 +291,7 @@ contains
         if (.not. (abs(l1) <= LME_LAM_MAX .and. abs(l2) <= LME_LAM_MAX)) return
         fmax = -huge(1.0_wp); amax = 0
         do a = 1, nn
-          f = -(gamma * (dN(1, a)**2 + dN(2, a)**2)) + (l1 * dN(1, a) + l2 * dN(2, a))
+          f = -qa(a) + (l1 * dN(1, a) + l2 * dN(2, a))
           N(a) = f
           if (f > fmax) then
             fmax = f; amax = a
@@ -427,6 +434,7 @@ contains
       real(wp), intent(out) :: dN(3, cap)       !! gradients
       integer, intent(out) :: iters             !! Newton iterations, or LME_FALLBACK
       integer, parameter :: BOX_MAX = 64        ! as in lme_point_2d
+      real(wp) :: qa(LEAN_MAX)                  ! γ|ξ_a|² of each candidate, as in 2D
       real(wp) :: xr(BOX_MAX), xr2(BOX_MAX), s(3), rd(3), xi2, xi3, xi22, xi32, q, f, fmax
       real(wp) :: qmax, x2max, xlo(3), xhi(3), l(3), c(3), sw, m1(3), m2(6), m3(10), logz
       real(wp) :: r(3), jm(6), ji(6), scl, rn, d(3), dn2, slope, logz0, b(3), mm(3, 3)
@@ -467,8 +475,9 @@ contains
           do i = i0, i1
             q = gamma * ((xr2(i - lo(1) + 1) + xi22) + xi32)
             if (q > cut) cycle
-            if (nn == cap) return
+            if (nn == cap .or. nn == LEAN_MAX) return
             nn = nn + 1
+            qa(nn) = q
             node(nn) = id0 + i
             dN(1, nn) = xr(i - lo(1) + 1); dN(2, nn) = xi2; dN(3, nn) = xi3
             f = -q + ((l(1) * dN(1, nn) + l(2) * xi2) + l(3) * xi3)
@@ -510,8 +519,7 @@ contains
         if (.not. all(abs(l) <= LME_LAM_MAX)) return
         fmax = -huge(1.0_wp); amax = 0
         do a = 1, nn
-          f = -(gamma * ((dN(1, a)**2 + dN(2, a)**2) + dN(3, a)**2)) + &
-              ((l(1) * dN(1, a) + l(2) * dN(2, a)) + l(3) * dN(3, a))
+          f = -qa(a) + ((l(1) * dN(1, a) + l(2) * dN(2, a)) + l(3) * dN(3, a))
           N(a) = f
           if (f > fmax) then
             fmax = f; amax = a
