@@ -14,10 +14,10 @@ submodule (empm_shape_lme) empm_shape_lme_batch
   use empm_shape_linear, only: shape_batch_fits, shape_keep_first_failure
   implicit none
 
-  !> Most candidates of the lean paths, whose γ|ξ_a|² they keep on the stack for the Newton
-  !> steps' exponents: never reached in 2D (the box of at most 64 columns holds fewer), γ
-  !> below about 0.14 in 3D (then the general path takes the point).
-  integer, parameter :: LEAN_MAX = 4096
+  !> Most candidates of the lean paths, whose γ|ξ_a|² they keep on the stack (8 kB, small
+  !> enough for a caller's thread stacks) for the Newton steps' exponents: with γ below about
+  !> 0.04 in 2D or 0.35 in 3D the general path takes the point.
+  integer, parameter :: LEAN_MAX = 1024
 
 contains
 
