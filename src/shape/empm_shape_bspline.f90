@@ -170,7 +170,8 @@ contains
     call shape_batch_fits(pts%np, basis, ibad, info, compact=self%layout(grid))
     if (info /= SHAPE_OK) return
     if (basis%layout /= BASIS_LISTS) then
-      ! BASIS_B9 or BASIS_B27 (shape_batch_fits admits no other). Done, unless a stencil reaches beyond the grid: then node lists, evaluated below.
+      ! BASIS_B9 or BASIS_B27 (shape_batch_fits admits no other). Done, unless a stencil
+      ! reaches beyond the grid: then node lists, evaluated below.
       if (shape_stencil_batch(grid, pts, .false., 0.0_wp, basis, ibad, info)) return
     end if
     if (.not. self%clamped .and. grid%ndim >= 2 .and. &

@@ -113,49 +113,34 @@ contains
     integer, intent(out) :: ibad                   !! first failing particle, 0 if none
     integer, intent(out) :: info                   !! SHAPE_OK or the failing particle's code
     integer :: p, pinfo, nc, c, p0, p1, b
-    logical :: q4
+    logical :: q4, lists3
     associate (unused_ => self); end associate
     call shape_batch_fits(pts%np, basis, ibad, info, &
                           compact=merge(BASIS_Q4, BASIS_LISTS, grid%ndim == 2))
     if (info /= SHAPE_OK) return
     q4 = basis%layout == BASIS_Q4
-    if (q4 .or. (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4)) then
-      ! 2D: one bilinear kernel call per chunk of particles.
+    lists3 = grid%ndim == 3 .and. basis%ndim == 3 .and. basis%maxn >= 8
+    if (q4 .or. lists3 .or. (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4)) then
+      ! 2D and 3D: one bilinear or trilinear kernel call per chunk of particles.
       if (q4) then
         basis%stride = grid%ln(1); basis%inv_h(1:2) = grid%inv_h(1:2)
       end if
       nc = empm_chunks(pts%np)
       ibad = huge(1)
       !$omp parallel do default(none) num_threads(nc) schedule(static, 1) &
-      !$omp   shared(nc, q4, grid, pts, basis) private(p0, p1, b) reduction(min: ibad) if(nc > 1)
+      !$omp   shared(nc, q4, lists3, grid, pts, basis) private(p0, p1, b) reduction(min: ibad) &
+      !$omp   if(nc > 1)
       do c = 0, nc - 1
         call empm_chunk_bounds(pts%np, nc, c, p0, p1)
         if (q4) then
           call q4_range(grid, p0, p1, pts%x, basis%cell, basis%t, b)
+        else if (lists3) then
+          call linear_range_3d(grid, p0, p1, pts%x, basis%maxn, basis%nn, basis%node, &
+                               basis%N, basis%dN, b)
         else
           call linear_range_2d(grid, p0, p1, pts%x, basis%maxn, basis%nn, basis%node, &
                                basis%N, basis%dN, b)
         end if
-        ibad = min(ibad, b)
-      end do
-      !$omp end parallel do
-      if (ibad == huge(1)) then
-        ibad = 0
-      else
-        info = SHAPE_OUTSIDE_GRID
-      end if
-      return
-    end if
-    if (grid%ndim == 3 .and. basis%ndim == 3 .and. basis%maxn >= 8) then
-      ! 3D: one trilinear kernel call per chunk of particles.
-      nc = empm_chunks(pts%np)
-      ibad = huge(1)
-      !$omp parallel do default(none) num_threads(nc) schedule(static, 1) &
-      !$omp   shared(nc, grid, pts, basis) private(p0, p1, b) reduction(min: ibad) if(nc > 1)
-      do c = 0, nc - 1
-        call empm_chunk_bounds(pts%np, nc, c, p0, p1)
-        call linear_range_3d(grid, p0, p1, pts%x, basis%maxn, basis%nn, basis%node, basis%N, &
-                             basis%dN, b)
         ibad = min(ibad, b)
       end do
       !$omp end parallel do

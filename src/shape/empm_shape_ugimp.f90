@@ -129,7 +129,8 @@ contains
     call shape_batch_fits(pts%np, basis, ibad, info, compact=self%layout(grid))
     if (info /= SHAPE_OK) return
     if (basis%layout /= BASIS_LISTS) then
-      ! BASIS_G9 or BASIS_G27 (shape_batch_fits admits no other). Done, unless a particle cannot be held: then node lists, evaluated below.
+      ! BASIS_G9 or BASIS_G27 (shape_batch_fits admits no other). Done, unless a particle
+      ! cannot be held: then node lists, evaluated below.
       if (shape_stencil_batch(grid, pts, .true., 0.5_wp * (1.0_wp + LP_TOL), basis, ibad, info)) &
         return
     end if

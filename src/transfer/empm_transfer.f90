@@ -23,8 +23,9 @@
 !> 2D) and [[empm_transfer_s27]] (`BASIS_B27`, `BASIS_G27`: 3D); node lists in 2D and 3D to
 !> the specialised loops of [[empm_transfer_2d]] and [[empm_transfer_3d]] for the kernels of
 !> the time step (momentum, mass + momentum, internal force, G2P, velocity gradient);
-!> everything else (1D, the mass alone, body forces) to the generic loops here. All paths do the same arithmetic in the same order (same bits). Nodal and particle
-!> arrays must be contiguous.
+!> everything else (1D, the mass alone, body forces) to the generic loops here. All paths do
+!> the same arithmetic in the same order (same bits). Nodal and particle arrays must be
+!> contiguous.
 module empm_transfer
   use empm_kinds, only: wp
   use empm_shape, only: empm_basis_t, BASIS_LISTS, BASIS_Q4, BASIS_B9, BASIS_B27, BASIS_G9, &
@@ -647,46 +648,17 @@ contains
     do ic = 0, nc - 1
       call empm_chunk_bounds(basis%np, nc, ic, p0, p1)
       if (.not. kick) then
-        call g2p_set(basis, q, p0, p1, u)
+        call g2p_range(basis, q, p0, p1, .false., 0.0_wp, u)
         cycle
       end if
       do q0 = p0, p1, KICK_BLOCK
         q1 = min(p1, q0 + KICK_BLOCK - 1)
-        call g2p_set(basis, q, q0, q1, u)
+        call g2p_range(basis, q, q0, q1, .false., 0.0_wp, u)
         call axpy_flat(d * (q1 - q0 + 1), ck, u(:, q0:q1), v(:, q0:q1))
       end do
     end do
     !$omp end parallel do
   end subroutine g2p_value
-
-  ! u_p = Σ_I N_Ip q_I for particles p0..p1 (the body of g2p_value), by layout and dimension.
-  pure subroutine g2p_set(basis, q, p0, p1, u)
-    type(empm_basis_t), intent(in) :: basis
-    real(wp), intent(in), contiguous :: q(:,:)
-    integer, intent(in) :: p0, p1
-    real(wp), intent(inout), contiguous :: u(:,:)
-    integer :: p, k
-    if (basis%layout == BASIS_Q4) then
-      call g2p_q4(basis%stride, p0, p1, basis%cell, basis%t, q, .false., 0.0_wp, u)
-    else if (is_s9(basis)) then
-      call g2p_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
-                  basis%layout == BASIS_G9, basis%wg, q, .false., 0.0_wp, u)
-    else if (is_s27(basis)) then
-      call g2p_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
-                   basis%layout == BASIS_G27, basis%wg, q, .false., 0.0_wp, u)
-    else if (basis%ndim == 2) then
-      call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .false., 0.0_wp, u)
-    else if (basis%ndim == 3) then
-      call g2p_3d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .false., 0.0_wp, u)
-    else
-      do p = p0, p1
-        u(:, p) = 0.0_wp
-        do k = 1, basis%nn(p)
-          u(:, p) = u(:, p) + basis%N(k, p) * q(:, basis%node(k, p))
-        end do
-      end do
-    end if
-  end subroutine g2p_set
 
   !> y += c a over n consecutive reals: the vectors of a range of particles, passed as contiguous
   !> sections (sequence association), so that the loop is flat and vectorises (over (ndim, np)
@@ -712,40 +684,49 @@ contains
     integer, intent(in) :: p0                        !! first particle
     integer, intent(in) :: p1                        !! last particle
     real(wp), intent(inout), contiguous :: u(:,:)    !! particle vectors (ndim, >= p1)
+    call g2p_range(basis, q, p0, p1, .true., c, u)
+  end subroutine g2p_block
+
+  !> The G2P of particles p0..p1, by layout and dimension: u_p += c Σ_I N_Ip q_I with `add`
+  !> ([[g2p_block]]), u_p = Σ_I N_Ip q_I without it ([[g2p_value]]).
+  pure subroutine g2p_range(basis, q, p0, p1, add, c, u)
+    type(empm_basis_t), intent(in) :: basis          !! shape functions at the particles
+    real(wp), intent(in), contiguous :: q(:,:)       !! nodal vectors (ndim, nnode)
+    integer, intent(in) :: p0                        !! first particle
+    integer, intent(in) :: p1                        !! last particle (p1 < p0: nothing to do)
+    logical, intent(in) :: add                       !! accumulate c Σ N q instead of overwriting
+    real(wp), intent(in) :: c                        !! scale (with `add`)
+    real(wp), intent(inout), contiguous :: u(:,:)    !! particle vectors (ndim, >= p1)
     real(wp) :: s(3)
     integer :: p, k, d
     d = basis%ndim
     if (p1 < p0) return
     if (basis%layout == BASIS_Q4) then
-      call g2p_q4(basis%stride, p0, p1, basis%cell, basis%t, q, .true., c, u)
-      return
-    end if
-    if (is_s9(basis)) then
+      call g2p_q4(basis%stride, p0, p1, basis%cell, basis%t, q, add, c, u)
+    else if (is_s9(basis)) then
       call g2p_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
-                  basis%layout == BASIS_G9, basis%wg, q, .true., c, u)
-      return
-    end if
-    if (is_s27(basis)) then
+                  basis%layout == BASIS_G9, basis%wg, q, add, c, u)
+    else if (is_s27(basis)) then
       call g2p_s27(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
-                   basis%layout == BASIS_G27, basis%wg, q, .true., c, u)
-      return
-    end if
-    if (d == 2) then
-      call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .true., c, u)
-      return
-    end if
-    if (d == 3) then
-      call g2p_3d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, .true., c, u)
-      return
-    end if
-    do p = p0, p1
-      s(1:d) = 0.0_wp
-      do k = 1, basis%nn(p)
-        s(1:d) = s(1:d) + basis%N(k, p) * q(:, basis%node(k, p))
+                   basis%layout == BASIS_G27, basis%wg, q, add, c, u)
+    else if (d == 2) then
+      call g2p_2d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, add, c, u)
+    else if (d == 3) then
+      call g2p_3d(basis%maxn, p0, p1, basis%nn, basis%node, basis%N, q, add, c, u)
+    else
+      do p = p0, p1
+        s(1:d) = 0.0_wp
+        do k = 1, basis%nn(p)
+          s(1:d) = s(1:d) + basis%N(k, p) * q(:, basis%node(k, p))
+        end do
+        if (add) then
+          u(:, p) = u(:, p) + c * s(1:d)
+        else
+          u(:, p) = s(1:d)
+        end if
       end do
-      u(:, p) = u(:, p) + c * s(1:d)
-    end do
-  end subroutine g2p_block
+    end if
+  end subroutine g2p_range
 
   !> Add a scaled interpolated nodal vector: u_p += c Σ_I N_Ip q_I.
   subroutine g2p_add_scaled(basis, c, q, u)
