@@ -15,7 +15,8 @@ module empm_integrator
   use empm_transfer, only: p2g_mass, p2g_mass_momentum, p2g_weighted, p2g_internal_force, &
                            p2g_body_force, &
                            nodal_divide_by_mass, g2p_value, &
-                           velocity_gradient, gradient_g2p_block, axpy_flat, empm_p2g_work_t
+                           velocity_gradient, gradient_g2p_block, g2p_block, axpy_flat, &
+                           empm_p2g_work_t
   use empm_timer, only: empm_phase_timer_t, PHASE_SHAPE, PHASE_P2G, PHASE_GRID, PHASE_STRESS, &
                         PHASE_G2P
   use empm_material, only: empm_material_ctx_t
@@ -588,7 +589,12 @@ contains
   !> particle is replaced by its mass-weighted nodal average ([[smooth_volumetric]]) before the
   !> material call: L_p += (ē_p − tr L_p)/ndim · I on the in-plane (2D) or full (3D) diagonal,
   !> the deviatoric part of L_p unchanged. Without it the update is unchanged, bit for bit.
-  subroutine update_stress(model, vel, dt, stat, integ, lprev)
+  !>
+  !> With `cx`, the particles also move by x_p += cx Σ N_Ip v_I in the gradient's pass (USL's
+  !> position update; the same bits as [[g2p_add_scaled]] before the call, one read of the
+  !> basis and the nodes fewer). A failing step leaves some particles moved and others not; the
+  !> time loop restores its last good state then.
+  subroutine update_stress(model, vel, dt, stat, integ, lprev, cx)
     type(empm_model_t), intent(inout) :: model      !! simulation state
     real(wp), intent(in), contiguous :: vel(:,:)    !! nodal velocities defining L (ndim, nnode)
     real(wp), intent(in) :: dt                      !! time step [s]
@@ -601,21 +607,24 @@ contains
                                                     !! material gets the trapezoidal gradient
                                                     !! of [[trapezoid_gradient]], and the drift's
                                                     !! correction `pts%dx` is formed
-    real(wp) :: none1(0), none2(0, 0), none3(0, 0, 0)
+    real(wp), intent(in), optional :: cx            !! with it, x_p += cx Σ N_Ip v_I [s]
+    real(wp) :: none1(0), none2(0, 0), none3(0, 0, 0), c
     logical :: sm, tz
     sm = .false.
     if (present(integ)) sm = integ%vol_smooth
     tz = present(lprev)
+    c = 0.0_wp
+    if (present(cx)) c = cx
     if (sm .and. tz) then
       call smooth_volumetric(integ, model, vel, lprev, dt)
-      call stress_blocks(model, vel, dt, stat, .true., integ%vs_tr, integ%vs_bar, .true., lprev)
+      call stress_blocks(model, vel, dt, stat, .true., integ%vs_tr, integ%vs_bar, .true., lprev, c)
     else if (sm) then
       call smooth_volumetric(integ, model, vel, none3, dt)
-      call stress_blocks(model, vel, dt, stat, .true., integ%vs_tr, integ%vs_bar, .false., none3)
+      call stress_blocks(model, vel, dt, stat, .true., integ%vs_tr, integ%vs_bar, .false., none3, c)
     else if (tz) then
-      call stress_blocks(model, vel, dt, stat, .false., none1, none2, .true., lprev)
+      call stress_blocks(model, vel, dt, stat, .false., none1, none2, .true., lprev, c)
     else
-      call stress_blocks(model, vel, dt, stat, .false., none1, none2, .false., none3)
+      call stress_blocks(model, vel, dt, stat, .false., none1, none2, .false., none3, c)
     end if
   end subroutine update_stress
 
@@ -844,8 +853,9 @@ contains
   !> The block loop of [[update_stress]]; with `tz`, L_p is first combined with `lprev`
   !> ([[trapezoid_gradient]]) and the block's drift correction `pts%dx` formed
   !> ([[drift_end]]); with `sm`, its volumetric part is then replaced by
-  !> ē_p = `bar(1, p)` (`tr(p)` = tr L_p) before the material call.
-  subroutine stress_blocks(model, vel, dt, stat, sm, tr, bar, tz, lprev)
+  !> ē_p = `bar(1, p)` (`tr(p)` = tr L_p) before the material call; with `cx` ≠ 0 the block's
+  !> particles move by cx Σ N v_I first.
+  subroutine stress_blocks(model, vel, dt, stat, sm, tr, bar, tz, lprev, cx)
     type(empm_model_t), intent(inout) :: model
     real(wp), intent(in), contiguous :: vel(:,:)
     real(wp), intent(in) :: dt
@@ -853,6 +863,7 @@ contains
     logical, intent(in) :: sm, tz
     real(wp), intent(in) :: tr(:), bar(:,:)
     real(wp), intent(in), contiguous :: lprev(:,:,:)
+    real(wp), intent(in) :: cx
     real(wp) :: Lb(3, 3, STRESS_BLOCK), dv, cm
     integer :: r, i0, i1, info, im, n, nc, c, a, b, q0, q1, bad, p, k, g0
     logical :: fine, we, ok
@@ -874,7 +885,7 @@ contains
       ! The first failing particle of the run, whichever block it is in.
       bad = huge(1)
       !$omp parallel do default(none) schedule(static, 1) &
-      !$omp& shared(model, vel, dt, i0, im, n, nc, sm, tr, bar, tz, lprev, we) &
+      !$omp& shared(model, vel, dt, i0, im, n, nc, sm, tr, bar, tz, lprev, we, cx) &
       !$omp& private(a, b, q0, q1, p, k, dv, Lb, info, ok, g0) firstprivate(ctx) &
       !$omp& reduction(min: bad) reduction(.and.: fine) reduction(max: cm) if(nc > 1)
       do c = 0, nc - 1
@@ -886,10 +897,14 @@ contains
           q1 = min(b, q0 + STRESS_BLOCK - 1)
           if (tz) then
             ! The trapezoidal drift: its gradient, and its position correction from the same
-            ! pass over the block's basis, dx = ½(dx − x) + ½Δt G2P(u) ([[drift_end]]).
+            ! pass over the block's basis, dx = ½(dx − x) + ½Δt G2P(u) ([[drift_end]]); a move
+            ! by `cx` first, as the call after [[g2p_add_scaled]] would see it.
+            if (cx /= 0.0_wp) call g2p_block(model%basis, cx, vel, q0, q1, model%pts%x)
             call half_back(q0, q1, model%pts%x, model%pts%dx)
             call gradient_g2p_block(model%basis, vel, q0, q1, Lb, 0.5_wp * dt, model%pts%dx)
             call trapezoid_gradient(dt, lprev(:, :, q0:q1), Lb)
+          else if (cx /= 0.0_wp) then
+            call gradient_g2p_block(model%basis, vel, q0, q1, Lb, cx, model%pts%x)
           else
             call velocity_gradient(model%basis, vel, q0, q1, Lb)
           end if

@@ -89,14 +89,15 @@ contains
       call nodes%constrain_velocity(nodes%vel, nodes%mom)
       call tm%lap(PHASE_GRID)
 
-      call g2p_value(basis, nodes%acc, pts%a)
-      call g2p_add_scaled(basis, dt, nodes%acc, pts%v)
-      call g2p_add_scaled(basis, dt, nodes%vel, pts%x)
+      ! a_p = Σ N a_I and v_p += Δt a_p in one pass; x_p += Δt Σ N v_I here, or for USL in
+      ! the stress update's pass over the same field (the same bits either way).
+      call g2p_value(basis, nodes%acc, pts%a, dt, pts%v)
+      if (self%variant /= EULER_USL) call g2p_add_scaled(basis, dt, nodes%vel, pts%x)
       call tm%lap(PHASE_G2P)
 
       select case (self%variant)
       case (EULER_USL)
-        call update_stress(model, nodes%vel, dt, stat, self)
+        call update_stress(model, nodes%vel, dt, stat, self, cx=dt)
         call tm%lap(PHASE_STRESS)
       case (EULER_MUSL)
         ! Re-map momentum from the updated particle velocities (Sulsky's MUSL).
