@@ -37,7 +37,7 @@ contains
     real(wp), intent(in) :: dt       !! time step [s]
     real(wp), intent(in) :: L(3,3)   !! velocity gradient [1/s]
     real(wp), intent(inout) :: s(6)  !! Cauchy stress, Voigt [Pa]
-    real(wp) :: a(3), c, Q(3,3), S3(3,3), T(3,3), ct, st, t11, t22, t12, t13
+    real(wp) :: a(3), c, Q(3,3), S3(3,3), T(3,3), M(3,3), ct, st, t11, t22, t12, t13
     integer :: i, j
     ! Axial vector of A = ½ΔtW: A x = a × x.
     a(1) = 0.25_wp * dt * (L(3,2) - L(2,3))
@@ -74,7 +74,18 @@ contains
     S3(2,3) = s(4); S3(3,2) = s(4)
     S3(1,3) = s(5); S3(3,1) = s(5)
     S3(1,2) = s(6); S3(2,1) = s(6)
-    T = matmul(Q, matmul(S3, transpose(Q)))
+    ! T = Q S3 Qᵀ written out (M = S3 Qᵀ, then Q M), each sum in matmul's order: the inline
+    ! matmuls with their temporaries took twice the instructions.
+    do j = 1, 3
+      do i = 1, 3
+        M(i,j) = S3(i,1) * Q(j,1) + S3(i,2) * Q(j,2) + S3(i,3) * Q(j,3)
+      end do
+    end do
+    do j = 1, 3
+      do i = 1, 3
+        T(i,j) = Q(i,1) * M(1,j) + Q(i,2) * M(2,j) + Q(i,3) * M(3,j)
+      end do
+    end do
     s(1) = T(1,1); s(2) = T(2,2); s(3) = T(3,3)
     s(4) = 0.5_wp * (T(2,3) + T(3,2))
     s(5) = 0.5_wp * (T(1,3) + T(3,1))
