@@ -329,37 +329,53 @@ def threads_section(path):
 
 
 def peers_section(path):
-    """Taichi's MLS-MPM script against empm's bspline2 (issue 17, item 3), each pair measured
-    back to back: the ratio per round, its median and range."""
+    """Taichi's MLS-MPM script against empm's bspline2 (issue 17, item 3) with pc_newmark and
+    with usl (mpm88's scheme), each measured back to back with the peer: the ratio per round,
+    its median and range."""
     if not path.exists():
         return []
-    peer, ours = {}, {}
+    runs = {"peer": {}, "peer_empm": {}, "peer_empm_usl": {}}
     with open(path) as f:
         for line in f:
             d = json.loads(line)
             r = d["run"]
-            key = (r["particles"], r["threads"], d["round"])
-            (peer if d["tag"] == "peer" else ours)[key] = r
+            runs.setdefault(d["tag"], {})[(r["particles"], r["threads"], d["round"])] = r
+    peer = runs["peer"]
     md = ["## Peers: Taichi MLS-MPM against `bspline2` (issue 17, item 3)", "",
           "`benchmarks/run --peers`: `benchmarks/peers/taichi_mpm88.py` (mpm88-style MLS-MPM: "
           "quadratic B-splines, APIC, float64, Taichi's CPU backend, the bench's block with "
-          "mpm88's one-scalar fluid stress) and `empm bench --shape bspline2` (pc_newmark: two "
-          "P2G passes, full stress, strain and F) on the same block, back to back, three rounds. "
+          "mpm88's one-scalar fluid stress) and `empm bench --shape bspline2` on the same block, "
+          "back to back, three rounds: with pc_newmark (the default: a P2G of momentum, one of "
+          "mass and momentum on the new basis, one of forces, the trapezoidal drift; full stress, "
+          "strain and F) and with usl (mpm88's scheme: one P2G of mass and momentum, one of "
+          "forces, the G2P of the acceleration, the velocity gradient with the move). "
           "Ratio: empm / Taichi particle-steps/s per round, median (range).", "",
-          "| particles | threads | Taichi | empm bspline2 | ratio | target | met |",
-          "|---|---|---|---|---|---|---|"]
-    for (np_, th) in sorted({(k[0], k[1]) for k in peer}):
-        keys = [k for k in peer if k[:2] == (np_, th) and k in ours]
+          "| particles | threads | Taichi | empm pc_newmark | ratio | empm usl | ratio | target "
+          "| met |",
+          "|---|---|---|---|---|---|---|---|---|"]
+
+    def ratio(tag, keys):
+        ours = runs.get(tag, {})
+        keys = [k for k in keys if k in ours]
         if not keys:
-            continue
+            return "–", "–", None
+        rates = [ours[k]["particle_steps_per_second"] for k in keys]
+        rs = [ours[k]["particle_steps_per_second"] / peer[k]["particle_steps_per_second"]
+              for k in keys]
+        rmed = statistics.median(rs)
+        return (fmt(statistics.median(rates)),
+                f"{rmed:.2f} ({min(rs):.2f}–{max(rs):.2f})", rmed)
+
+    for (np_, th) in sorted({(k[0], k[1]) for k in peer}):
+        keys = [k for k in peer if k[:2] == (np_, th)]
         tp = [peer[k]["particle_steps_per_second"] for k in keys]
-        ep = [ours[k]["particle_steps_per_second"] for k in keys]
-        ratios = [ours[k]["particle_steps_per_second"] / peer[k]["particle_steps_per_second"]
-                  for k in keys]
-        rmed = statistics.median(ratios)
-        md.append(f"| {np_} | {th} | {fmt(statistics.median(tp))} | {fmt(statistics.median(ep))} "
-                  f"| {rmed:.2f} ({min(ratios):.2f}–{max(ratios):.2f}) | ≥ 1.5 | "
-                  f"{'yes' if rmed >= 1.5 else '**no**'} |")
+        pc_rate, pc_ratio, pc_med = ratio("peer_empm", keys)
+        usl_rate, usl_ratio, usl_med = ratio("peer_empm_usl", keys)
+        if pc_med is None:
+            continue
+        met = "yes" if pc_med >= 1.5 else "**no**"
+        md.append(f"| {np_} | {th} | {fmt(statistics.median(tp))} | {pc_rate} | {pc_ratio} "
+                  f"| {usl_rate} | {usl_ratio} | ≥ 1.5 | {met} |")
     md.append("")
     return md
 

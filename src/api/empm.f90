@@ -21,7 +21,7 @@ module empm
                         EMPM_SHAPE_OK => SHAPE_OK, EMPM_BASIS_LISTS => BASIS_LISTS, &
                         EMPM_BASIS_Q4 => BASIS_Q4, EMPM_BASIS_B9 => BASIS_B9, &
                         EMPM_BASIS_B27 => BASIS_B27, EMPM_BASIS_G9 => BASIS_G9, &
-                        EMPM_BASIS_G27 => BASIS_G27
+                        EMPM_BASIS_G27 => BASIS_G27, EMPM_BASIS_Q8 => BASIS_Q8
   use empm_shape_lme, only: empm_shape_lme_t, EMPM_LME_REMEDY_NONE => LME_REMEDY_NONE, &
                             EMPM_LME_REMEDY_ENLARGE => LME_REMEDY_ENLARGE
   use empm_lme_legacy, only: empm_lme_basis
@@ -57,7 +57,8 @@ module empm
   public :: empm_grid_t, empm_nodes_t, empm_particles_t
   public :: empm_fill, EMPM_GEOM_BOX, EMPM_GEOM_DISK, EMPM_PLACE_GAUSS, EMPM_PLACE_VOXEL
   public :: empm_shape_t, empm_basis_t, empm_shape_status_text, EMPM_SHAPE_OK, EMPM_BASIS_LISTS
-  public :: EMPM_BASIS_Q4, EMPM_BASIS_B9, EMPM_BASIS_B27, EMPM_BASIS_G9, EMPM_BASIS_G27
+  public :: EMPM_BASIS_Q4, EMPM_BASIS_Q8, EMPM_BASIS_B9, EMPM_BASIS_B27, EMPM_BASIS_G9, &
+            EMPM_BASIS_G27
   public :: empm_shape_lme_t, EMPM_LME_REMEDY_NONE, EMPM_LME_REMEDY_ENLARGE, empm_lme_basis
   ! Materials and loads
   public :: empm_material_t

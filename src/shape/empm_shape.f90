@@ -17,7 +17,7 @@ module empm_shape
   implicit none
   private
   public :: empm_shape_t, empm_basis_t, BASIS_LISTS, BASIS_Q4, BASIS_B9, BASIS_B27, BASIS_G9, &
-            BASIS_G27, basis_q4_weights, basis_stencil_factors
+            BASIS_G27, BASIS_Q8, basis_q4_weights, basis_q8_weights, basis_stencil_factors
   public :: SHAPE_OK, SHAPE_OUTSIDE_GRID, SHAPE_SUPPORT_CLIPPED, SHAPE_NOT_CONVERGED, &
             SHAPE_OUTSIDE_HULL, SHAPE_SINGULAR, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, &
             SHAPE_NO_MEMORY, shape_status_text
@@ -43,8 +43,10 @@ module empm_shape
   integer, parameter :: BASIS_G9 = 4    !! layout: uGIMP on a 2D grid, the first node of the 3 × 3
                                         !! stencil and the stored 1D factors per particle
   integer, parameter :: BASIS_G27 = 5   !! layout: BASIS_G9 on a 3D grid
+  integer, parameter :: BASIS_Q8 = 6    !! layout: trilinear on a 3D grid, the cell and three
+                                        !! local coordinates per particle (values recomputed)
 
-  !> Shape-function values and gradients for every particle, in one of six layouts.
+  !> Shape-function values and gradients for every particle, in one of seven layouts.
   !>
   !> `BASIS_LISTS` (any family): per particle the number of supporting nodes, their indices,
   !> values and gradients, contiguous per particle. Compact layouts, chosen by a family
@@ -54,6 +56,9 @@ module empm_shape
   !> - `BASIS_Q4` (linear shapes on a 2D grid): `cell` the lowest node of the particle's cell,
   !>   t ∈ [0, 1]²; the four nodes cell, cell + 1, cell + stride, cell + stride + 1 and the
   !>   bilinear values of [[basis_q4_weights]];
+  !> - `BASIS_Q8` (linear shapes on a 3D grid): the same in 3D, t ∈ [0, 1]³, the eight nodes
+  !>   cell + a + stride·b + stride2·c (a, b, c = 0, 1) and the trilinear values of
+  !>   [[basis_q8_weights]];
   !> - `BASIS_B9` (uniform quadratic B-splines on a 2D grid): `cell` the first node of the
   !>   3 × 3 stencil (i₁ = ⌊s − ½⌋ per direction, s the position in cells), t = s − i₁ ∈
   !>   [0.5, 1.5)²; the nodes cell + a + stride·b (a, b = 0, 1, 2) and the tensor products of
@@ -71,8 +76,8 @@ module empm_shape
   !> Either way, [[basis_get]] gives one particle's nodes, values and gradients, the same bits
   !> as the transfers use.
   type :: empm_basis_t
-    integer :: layout = BASIS_LISTS         !! BASIS_LISTS or a compact layout (BASIS_Q4, BASIS_B9,
-                                            !! BASIS_B27, BASIS_G9, BASIS_G27)
+    integer :: layout = BASIS_LISTS         !! BASIS_LISTS or a compact layout (BASIS_Q4, BASIS_Q8,
+                                            !! BASIS_B9, BASIS_B27, BASIS_G9, BASIS_G27)
     integer :: ndim = 0                     !! spatial dimension
     integer :: maxn = 0                     !! capacity: nodes per particle
     integer :: np = 0                       !! number of particles
@@ -83,7 +88,7 @@ module empm_shape
     integer, allocatable :: cell(:)         !! compact: first node of the particle's stencil (np)
     real(wp), allocatable :: t(:,:)         !! compact: local coordinates (ndim, np)
     integer :: stride = 0                   !! compact: nodes along x (set by the family's batch)
-    integer :: stride2 = 0                  !! 3D stencils: nodes per x-y plane (set by the batch)
+    integer :: stride2 = 0                  !! 3D compact: nodes per x-y plane (set by the batch)
     real(wp), allocatable :: wg(:,:,:,:)    !! uGIMP stencils: the 1D values (wg(:, 1, d, p)) and
                                             !! slopes (wg(:, 2, d, p)) of the 3 stencil nodes per
                                             !! direction (3, 2, ndim, np); (3, 2, ndim, 1), unused,
@@ -224,8 +229,9 @@ contains
   end function shape_layout
 
   !> Allocate basis storage for `np` particles with up to `maxn` nodes each, in `layout`
-  !> (default BASIS_LISTS; BASIS_Q4 needs ndim = 2 and maxn >= 4, BASIS_B9 and BASIS_G9 ndim = 2
-  !> and maxn >= 9, BASIS_B27 and BASIS_G27 ndim = 3 and maxn >= 27, otherwise lists are used).
+  !> (default BASIS_LISTS; BASIS_Q4 needs ndim = 2 and maxn >= 4, BASIS_Q8 ndim = 3 and
+  !> maxn >= 8, BASIS_B9 and BASIS_G9 ndim = 2 and maxn >= 9, BASIS_B27 and BASIS_G27 ndim = 3
+  !> and maxn >= 27, otherwise lists are used).
   !> An allocation failure is reported in `err` when present (with the memory asked for),
   !> otherwise it stops the program.
   subroutine basis_alloc(self, ndim, maxn, np, layout, err)
@@ -245,6 +251,7 @@ contains
     self%layout = BASIS_LISTS
     if (present(layout)) then
       if (layout == BASIS_Q4 .and. ndim == 2 .and. maxn >= 4) self%layout = BASIS_Q4
+      if (layout == BASIS_Q8 .and. ndim == 3 .and. maxn >= 8) self%layout = BASIS_Q8
       if (layout == BASIS_B9 .and. ndim == 2 .and. maxn >= 9) self%layout = BASIS_B9
       if (layout == BASIS_B27 .and. ndim == 3 .and. maxn >= 27) self%layout = BASIS_B27
       if (layout == BASIS_G9 .and. ndim == 2 .and. maxn >= 9) self%layout = BASIS_G9
@@ -324,6 +331,18 @@ contains
       call basis_q4_weights(self%t(1, p), self%t(2, p), self%inv_h(1), self%inv_h(2), &
                             N(1:4), dN(1:2, 1:4))
       nn = 4
+    else if (self%layout == BASIS_Q8) then
+      if (size(node) < 8 .or. size(N) < 8 .or. size(dN, 1) < 3 .or. size(dN, 2) < 8) return
+      id = self%cell(p)
+      do c = 0, 1
+        do b = 0, 1
+          do a = 0, 1
+            node(1 + a + 2 * b + 4 * c) = id + a + self%stride * b + self%stride2 * c
+          end do
+        end do
+      end do
+      call basis_q8_weights(self%t(:, p), self%inv_h, N(1:8), dN(1:3, 1:8))
+      nn = 8
     else
       if (size(node) < self%nn(p) .or. size(N) < self%nn(p) .or. size(dN, 1) < self%ndim &
           .or. size(dN, 2) < self%nn(p)) return
@@ -350,6 +369,24 @@ contains
   end subroutine basis_q4_weights
 
   include 'empm_q4_weights.inc'
+
+  !> Trilinear values and gradients from the local coordinates t of a cell with 1/h = h per
+  !> direction; nodes in increasing index order (x fastest). The Q8 basis for [[basis_get]];
+  !> the expressions are those of empm_q8_weights.inc and empm_q8_gradients.inc, which the Q8
+  !> transfers include too, and
+  !> the linear family's 3D node lists form the same products (the same bits in both layouts).
+  pure subroutine basis_q8_weights(t, h, N, dN)
+    real(wp), intent(in) :: t(3)      !! local coordinates, in [0, 1]
+    real(wp), intent(in) :: h(3)      !! 1/h per direction
+    real(wp), intent(out) :: N(8)     !! values
+    real(wp), intent(out) :: dN(3, 8) !! gradients
+    real(wp) :: tp(3), m(3), u1, u2, u3, a00, a10, a01, a11, c00, c10, c01, c11, e00, e10, e01, e11
+    call q8_values(t, N)
+    tp = t; m = -h
+    include 'empm_q8_gradients.inc'
+  end subroutine basis_q8_weights
+
+  include 'empm_q8_weights.inc'
 
   !> The 1D factors of a compact stencil layout along one direction (those of
   !> empm_stencil_weights.inc, which the stencil transfers include too), and the stencil nodes

@@ -14,7 +14,7 @@ module empm_shape_linear
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, SHAPE_NO_MEMORY, &
-                        BASIS_LISTS, BASIS_Q4, BASIS_G9, BASIS_G27, basis_q4_weights, &
+                        BASIS_LISTS, BASIS_Q4, BASIS_Q8, BASIS_G9, BASIS_G27, basis_q4_weights, &
                         basis_stencil_factors
   implicit none
   private
@@ -53,14 +53,15 @@ contains
     linear_max_nodes = 2**grid%ndim
   end function linear_max_nodes
 
-  !> Basis layout: BASIS_Q4 on a 2D grid (the cell and two local coordinates per particle),
-  !> node lists otherwise.
+  !> Basis layout: BASIS_Q4 on a 2D grid, BASIS_Q8 on a 3D one (the cell and the local
+  !> coordinates per particle), node lists in 1D.
   pure integer function linear_layout(self, grid)
     class(empm_shape_linear_t), intent(in) :: self !! shape family
     type(empm_grid_t), intent(in) :: grid          !! background grid
     associate (unused_ => self); end associate
     linear_layout = BASIS_LISTS
     if (grid%ndim == 2) linear_layout = BASIS_Q4
+    if (grid%ndim == 3) linear_layout = BASIS_Q8
   end function linear_layout
 
   !> Registry name of the family.
@@ -113,27 +114,29 @@ contains
     integer, intent(out) :: ibad                   !! first failing particle, 0 if none
     integer, intent(out) :: info                   !! SHAPE_OK or the failing particle's code
     integer :: p, pinfo, nc, c, p0, p1, b
-    logical :: q4, lists3
-    associate (unused_ => self); end associate
-    call shape_batch_fits(pts%np, basis, ibad, info, &
-                          compact=merge(BASIS_Q4, BASIS_LISTS, grid%ndim == 2))
+    logical :: q4, q8, lists3
+    call shape_batch_fits(pts%np, basis, ibad, info, compact=self%layout(grid))
     if (info /= SHAPE_OK) return
     q4 = basis%layout == BASIS_Q4
+    q8 = basis%layout == BASIS_Q8
     lists3 = grid%ndim == 3 .and. basis%ndim == 3 .and. basis%maxn >= 8
-    if (q4 .or. lists3 .or. (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4)) then
+    if (q4 .or. q8 .or. lists3 .or. (grid%ndim == 2 .and. basis%ndim == 2 .and. basis%maxn >= 4)) then
       ! 2D and 3D: one bilinear or trilinear kernel call per chunk of particles.
-      if (q4) then
-        basis%stride = grid%ln(1); basis%inv_h(1:2) = grid%inv_h(1:2)
+      if (q4 .or. q8) then
+        basis%stride = grid%ln(1); basis%inv_h(1:grid%ndim) = grid%inv_h(1:grid%ndim)
+        if (q8) basis%stride2 = grid%ln(1) * grid%ln(2)
       end if
       nc = empm_chunks(pts%np)
       ibad = huge(1)
       !$omp parallel do default(none) num_threads(nc) schedule(static, 1) &
-      !$omp   shared(nc, q4, lists3, grid, pts, basis) private(p0, p1, b) reduction(min: ibad) &
-      !$omp   if(nc > 1)
+      !$omp   shared(nc, q4, q8, lists3, grid, pts, basis) private(p0, p1, b) &
+      !$omp   reduction(min: ibad) if(nc > 1)
       do c = 0, nc - 1
         call empm_chunk_bounds(pts%np, nc, c, p0, p1)
         if (q4) then
           call q4_range(grid, p0, p1, pts%x, basis%cell, basis%t, b)
+        else if (q8) then
+          call q8_range(grid, p0, p1, pts%x, basis%cell, basis%t, b)
         else if (lists3) then
           call linear_range_3d(grid, p0, p1, pts%x, basis%maxn, basis%nn, basis%node, &
                                basis%N, basis%dN, b)
@@ -340,6 +343,41 @@ contains
       t(2, p) = min(s2 - j0, 1.0_wp)
     end do
   end subroutine q4_range
+
+  !> The compact trilinear basis (BASIS_Q8) at particles p0..p1: the lowest node of the cell
+  !> and the local coordinates, located as [[linear_range_3d]] locates a particle (inside the
+  !> box s ≥ 0, so its clamps from below change nothing: the same bits). A particle outside
+  !> the closed grid box (which a NaN coordinate fails too) is left as it was; `ibad` is the
+  !> first one, huge(1) if none.
+  pure subroutine q8_range(grid, p0, p1, x, cell, t, ibad)
+    type(empm_grid_t), intent(in) :: grid    !! background grid (3D)
+    integer, intent(in) :: p0                !! first particle
+    integer, intent(in) :: p1                !! last particle
+    real(wp), intent(in) :: x(3, *)          !! particle positions
+    integer, intent(inout) :: cell(*)        !! lowest node of each particle's cell
+    real(wp), intent(inout) :: t(3, *)       !! local coordinates
+    integer, intent(out) :: ibad             !! first particle outside the grid, huge(1) if none
+    real(wp) :: o(3), e(3), h(3), s
+    integer :: p, d, i0, n(3), cmax(3)
+    o = grid%origin(1:3); h = grid%inv_h(1:3)
+    e = grid%origin(1:3) + grid%ncell(1:3) * grid%h(1:3)
+    n = [1, grid%ln(1), grid%ln(1) * grid%ln(2)]; cmax = grid%ncell(1:3) - 1
+    ibad = huge(1)
+    do p = p0, p1
+      if (.not. (x(1, p) >= o(1) .and. x(1, p) <= e(1) .and. x(2, p) >= o(2) .and. &
+                 x(2, p) <= e(2) .and. x(3, p) >= o(3) .and. x(3, p) <= e(3))) then
+        ibad = min(ibad, p)
+        cycle
+      end if
+      cell(p) = grid%id0
+      do d = 1, 3
+        s = (x(d, p) - o(d)) * h(d)
+        i0 = min(int(s), cmax(d))
+        cell(p) = cell(p) + n(d) * i0
+        t(d, p) = min(s - i0, 1.0_wp)
+      end do
+    end do
+  end subroutine q8_range
 
   !> Reset tensor-product factors to the neutral values used along directions beyond ndim:
   !> one node at index 0 with value 1 and derivative 0.

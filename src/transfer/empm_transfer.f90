@@ -18,7 +18,8 @@
 !> every P2G kernel; what it accumulates is selected once per particle range ([[p2g_range]]).
 !>
 !> Every kernel dispatches on the basis layout and dimension once per particle chunk: the
-!> compact bilinear layout (`BASIS_Q4`) goes to [[empm_transfer_q4]], the compact 3^ndim
+!> compact bilinear and trilinear layouts (`BASIS_Q4`, `BASIS_Q8`) go to [[empm_transfer_q4]]
+!> and [[empm_transfer_q8]], the compact 3^ndim
 !> stencils of quadratic B-splines and uGIMP to [[empm_transfer_s9]] (`BASIS_B9`, `BASIS_G9`:
 !> 2D) and [[empm_transfer_s27]] (`BASIS_B27`, `BASIS_G27`: 3D); node lists in 2D and 3D to
 !> the specialised loops of [[empm_transfer_2d]] and [[empm_transfer_3d]] for the kernels of
@@ -28,8 +29,8 @@
 !> contiguous.
 module empm_transfer
   use empm_kinds, only: wp
-  use empm_shape, only: empm_basis_t, BASIS_LISTS, BASIS_Q4, BASIS_B9, BASIS_B27, BASIS_G9, &
-                        BASIS_G27
+  use empm_shape, only: empm_basis_t, BASIS_LISTS, BASIS_Q4, BASIS_Q8, BASIS_B9, BASIS_B27, &
+                        BASIS_G9, BASIS_G27
   use empm_nodes, only: empm_nodes_t
   use empm_parallel, only: EMPM_OMP_MIN_PARTICLES, empm_chunks, empm_chunk_bounds
   use empm_transfer_2d, only: weighted_2d, mass_momentum_2d, internal_force_2d, &
@@ -38,6 +39,8 @@ module empm_transfer
                               velocity_gradient_3d, g2p_3d, gradient_g2p_3d
   use empm_transfer_q4, only: mass_q4, weighted_q4, mass_momentum_q4, body_force_q4, &
                               internal_force_q4, velocity_gradient_q4, g2p_q4, gradient_g2p_q4
+  use empm_transfer_q8, only: mass_q8, weighted_q8, mass_momentum_q8, body_force_q8, &
+                              internal_force_q8, velocity_gradient_q8, g2p_q8, gradient_g2p_q8
   use empm_transfer_s9, only: mass_s9, weighted_s9, mass_momentum_s9, body_force_s9, &
                               internal_force_s9, velocity_gradient_s9, g2p_s9, gradient_g2p_s9
   use empm_transfer_s27, only: mass_s27, weighted_s27, mass_momentum_s27, body_force_s27, &
@@ -131,6 +134,7 @@ contains
     ! A compact layout's nodes run from `cell` to `cell + span` (the last node of its stencil).
     span = 0
     if (basis%layout == BASIS_Q4) span = basis%stride + 1
+    if (basis%layout == BASIS_Q8) span = basis%stride2 + basis%stride + 1
     if (is_s9(basis)) span = 2 * basis%stride + 2
     if (is_s27(basis)) span = 2 * basis%stride2 + 2 * basis%stride + 2
     ! Sub-chunk by sub-chunk, each one's particles shared by all threads (a loop over the
@@ -423,6 +427,9 @@ contains
     if (basis%layout == BASIS_Q4) then
       call mass_q4(basis%stride, p0, p1, basis%cell, basis%t, m, mass); return
     end if
+    if (basis%layout == BASIS_Q8) then
+      call mass_q8(basis%stride, basis%stride2, p0, p1, basis%cell, basis%t, m, mass); return
+    end if
     if (is_s9(basis)) then
       call mass_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
                    basis%layout == BASIS_G9, basis%wg, m, mass); return
@@ -452,6 +459,9 @@ contains
     integer :: p, k, I, d
     if (basis%layout == BASIS_Q4) then
       call weighted_q4(basis%stride, p0, p1, basis%cell, basis%t, m, u, c, w, q); return
+    end if
+    if (basis%layout == BASIS_Q8) then
+      call weighted_q8(basis%stride, basis%stride2, p0, p1, basis%cell, basis%t, m, u, c, w, q); return
     end if
     if (is_s9(basis)) then
       call weighted_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
@@ -501,6 +511,9 @@ contains
     if (basis%layout == BASIS_Q4) then
       call mass_momentum_q4(basis%stride, p0, p1, basis%cell, basis%t, m, u, c, w, mass, q, &
                             fill, vol, vn)
+    else if (basis%layout == BASIS_Q8) then
+      call mass_momentum_q8(basis%stride, basis%stride2, p0, p1, basis%cell, basis%t, m, u, c, w, mass, &
+                            q, fill, vol, vn)
     else if (is_s9(basis)) then
       call mass_momentum_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
                             basis%layout == BASIS_G9, basis%wg, m, u, c, w, &
@@ -535,6 +548,11 @@ contains
     if (basis%layout == BASIS_Q4) then
       call internal_force_q4(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, vol, &
                              stress, f)
+      return
+    end if
+    if (basis%layout == BASIS_Q8) then
+      call internal_force_q8(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                             vol, stress, f)
       return
     end if
     if (is_s9(basis)) then
@@ -590,6 +608,10 @@ contains
     integer :: p, k, I, d
     if (basis%layout == BASIS_Q4) then
       call body_force_q4(basis%stride, p0, p1, basis%cell, basis%t, m, g, b, use_b, f); return
+    end if
+    if (basis%layout == BASIS_Q8) then
+      call body_force_q8(basis%stride, basis%stride2, p0, p1, basis%cell, basis%t, m, g, b, use_b, f)
+      return
     end if
     if (is_s9(basis)) then
       call body_force_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
@@ -703,6 +725,8 @@ contains
     if (p1 < p0) return
     if (basis%layout == BASIS_Q4) then
       call g2p_q4(basis%stride, p0, p1, basis%cell, basis%t, q, add, c, u)
+    else if (basis%layout == BASIS_Q8) then
+      call g2p_q8(basis%stride, basis%stride2, p0, p1, basis%cell, basis%t, q, add, c, u)
     else if (is_s9(basis)) then
       call g2p_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
                   basis%layout == BASIS_G9, basis%wg, q, add, c, u)
@@ -764,6 +788,11 @@ contains
       call velocity_gradient_q4(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, v, L)
       return
     end if
+    if (basis%layout == BASIS_Q8) then
+      call velocity_gradient_q8(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, &
+                                v, L)
+      return
+    end if
     if (is_s9(basis)) then
       call velocity_gradient_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
                                 basis%layout == BASIS_G9, basis%wg, v, L)
@@ -817,6 +846,9 @@ contains
     if (p1 < p0) return
     if (basis%layout == BASIS_Q4) then
       call gradient_g2p_q4(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, v, L, c, u)
+    else if (basis%layout == BASIS_Q8) then
+      call gradient_g2p_q8(basis%stride, basis%stride2, basis%inv_h, p0, p1, basis%cell, basis%t, v, L, &
+                           c, u)
     else if (is_s9(basis)) then
       call gradient_g2p_s9(basis%stride, basis%inv_h, p0, p1, basis%cell, basis%t, &
                            basis%layout == BASIS_G9, basis%wg, v, L, c, u)
