@@ -20,7 +20,7 @@ module empm_material_linear_elastic
   use empm_params, only: empm_param_t, empm_param, PARAM_REAL, PARAM_STR
   use empm_namelist, only: empm_group_t
   use empm_material, only: empm_material_t, empm_material_ctx_t
-  use empm_plasticity, only: jaumann_rotate
+  use empm_plasticity, only: jaumann_rotate_block
   implicit none
   private
   public :: empm_linear_elastic_t, empm_elastic_check, empm_lame
@@ -218,6 +218,9 @@ contains
       info = -1
       return
     end if
+    ! The rotation of the start-of-step stresses first, for the block (a call per particle
+    ! cost as much as the rotation); the particles the loop below rejects are not rotated.
+    if (self%jaumann) call jaumann_rotate_block(dt, n, L, stress)
     do p = 1, n
       de(1) = dt * L(1,1,p)
       de(2) = dt * L(2,2,p)
@@ -232,7 +235,6 @@ contains
         cycle
       end if
       strain(:,p) = strain(:,p) + de
-      if (self%jaumann) call jaumann_rotate(dt, L(:,:,p), stress(:,p))
       stress(1:3,p) = stress(1:3,p) + self%lambda * tr + 2.0_wp * self%mu * de(1:3)
       stress(4:6,p) = stress(4:6,p) + 2.0_wp * self%mu * de(4:6)
       rho(p) = rho(p) / (1.0_wp + tr)

@@ -9,7 +9,8 @@ module empm_plasticity
   use empm_kinds, only: wp
   implicit none
   private
-  public :: strain_increment, jaumann_rotate, elastic_increment, mean_deviator
+  public :: strain_increment, jaumann_rotate, jaumann_rotate_block, elastic_increment, &
+            mean_deviator
   public :: principal_decompose, principal_compose
 
 contains
@@ -37,24 +38,14 @@ contains
     real(wp), intent(in) :: dt       !! time step [s]
     real(wp), intent(in) :: L(3,3)   !! velocity gradient [1/s]
     real(wp), intent(inout) :: s(6)  !! Cauchy stress, Voigt [Pa]
-    real(wp) :: a(3), c, Q(3,3), S3(3,3), T(3,3), M(3,3), ct, st, t11, t22, t12, t13
+    real(wp) :: a(3), c, Q(3,3), S3(3,3), T(3,3), M(3,3)
     integer :: i, j
     ! Axial vector of A = ½ΔtW: A x = a × x.
     a(1) = 0.25_wp * dt * (L(3,2) - L(2,3))
     a(2) = 0.25_wp * dt * (L(1,3) - L(3,1))
     a(3) = 0.25_wp * dt * (L(2,1) - L(1,2))
     if (a(1) == 0.0_wp .and. a(2) == 0.0_wp) then
-      if (a(3) == 0.0_wp) return
-      ! Spin about z alone (every 2D step): Q is the in-plane rotation cos = 1 − c a3²,
-      ! sin = c a3 (the same Q as below, written out: a quarter of the 3×3 products).
-      c = 2.0_wp / (1.0_wp + a(3)**2)
-      ct = 1.0_wp - c * a(3)**2; st = c * a(3)
-      t11 = ct * ct * s(1) - 2.0_wp * ct * st * s(6) + st * st * s(2)
-      t22 = st * st * s(1) + 2.0_wp * ct * st * s(6) + ct * ct * s(2)
-      t12 = ct * st * (s(1) - s(2)) + (ct * ct - st * st) * s(6)
-      t13 = ct * s(5) - st * s(4)
-      s(4) = st * s(5) + ct * s(4)
-      s(1) = t11; s(2) = t22; s(5) = t13; s(6) = t12
+      call rotate_about_z(a(3), s)
       return
     end if
     ! Q = I + 2/(1 + a·a) (A + A²), with A² = a aᵀ − (a·a) I.
@@ -91,6 +82,47 @@ contains
     s(5) = 0.5_wp * (T(1,3) + T(3,1))
     s(6) = 0.5_wp * (T(1,2) + T(2,1))
   end subroutine jaumann_rotate
+
+  !> [[jaumann_rotate]] for a spin about z alone (every 2D step), a3 = ¼Δt(L21 − L12): Q is
+  !> the in-plane rotation cos = 1 − c a3², sin = c a3, c = 2/(1 + a3²) (the general Q,
+  !> written out: a quarter of the 3×3 products). Small, so that callers inline it.
+  pure subroutine rotate_about_z(a3, s)
+    real(wp), intent(in) :: a3       !! axial vector's z component of ½ΔtW
+    real(wp), intent(inout) :: s(6)  !! Cauchy stress, Voigt [Pa]
+    real(wp) :: c, ct, st, t11, t22, t12, t13
+    if (a3 == 0.0_wp) return
+    c = 2.0_wp / (1.0_wp + a3**2)
+    ct = 1.0_wp - c * a3**2; st = c * a3
+    t11 = ct * ct * s(1) - 2.0_wp * ct * st * s(6) + st * st * s(2)
+    t22 = st * st * s(1) + 2.0_wp * ct * st * s(6) + ct * ct * s(2)
+    t12 = ct * st * (s(1) - s(2)) + (ct * ct - st * st) * s(6)
+    t13 = ct * s(5) - st * s(4)
+    s(4) = st * s(5) + ct * s(4)
+    s(1) = t11; s(2) = t22; s(5) = t13; s(6) = t12
+  end subroutine rotate_about_z
+
+  !> [[jaumann_rotate]] of the stresses s(:, p) of particles 1..n with the velocity gradients
+  !> L(:, :, p), skipping those whose step would invert them, 1 + Δt tr L ≤ 0 (tr L summed as
+  !> [[strain_increment]]'s diagonal is: the models update no stress there). For a model that
+  !> rotates before its increment: one call per block instead of one per particle, the
+  !> rotation inlined into this loop.
+  pure subroutine jaumann_rotate_block(dt, n, L, s)
+    real(wp), intent(in) :: dt           !! time step [s]
+    integer, intent(in) :: n             !! number of particles
+    real(wp), intent(in) :: L(3, 3, n)   !! velocity gradients [1/s]
+    real(wp), intent(inout) :: s(6, n)   !! Cauchy stresses, Voigt [Pa]
+    integer :: p
+    do p = 1, n
+      if (1.0_wp + (dt * L(1,1,p) + dt * L(2,2,p) + dt * L(3,3,p)) <= 0.0_wp) cycle
+      ! The axial vector as jaumann_rotate forms it; the 2D case without the call.
+      if (0.25_wp * dt * (L(3,2,p) - L(2,3,p)) == 0.0_wp .and. &
+          0.25_wp * dt * (L(1,3,p) - L(3,1,p)) == 0.0_wp) then
+        call rotate_about_z(0.25_wp * dt * (L(2,1,p) - L(1,2,p)), s(:,p))
+      else
+        call jaumann_rotate(dt, L(:,:,p), s(:,p))
+      end if
+    end do
+  end subroutine jaumann_rotate_block
 
   !> Isotropic elastic stress increment K tr(Δε) I + 2G dev(Δε).
   pure function elastic_increment(K, G, de) result(ds)
