@@ -38,16 +38,24 @@ contains
     real(wp), intent(in) :: dt       !! time step [s]
     real(wp), intent(in) :: L(3,3)   !! velocity gradient [1/s]
     real(wp), intent(inout) :: s(6)  !! Cauchy stress, Voigt [Pa]
-    real(wp) :: a(3), c, Q(3,3), S3(3,3), T(3,3), M(3,3)
-    integer :: i, j
+    real(wp) :: a(3)
     ! Axial vector of A = ½ΔtW: A x = a × x.
     a(1) = 0.25_wp * dt * (L(3,2) - L(2,3))
     a(2) = 0.25_wp * dt * (L(1,3) - L(3,1))
     a(3) = 0.25_wp * dt * (L(2,1) - L(1,2))
     if (a(1) == 0.0_wp .and. a(2) == 0.0_wp) then
       call rotate_about_z(a(3), s)
-      return
+    else
+      call rotate_general(a, s)
     end if
+  end subroutine jaumann_rotate
+
+  !> [[jaumann_rotate]] for a general spin, a the axial vector of ½ΔtW.
+  pure subroutine rotate_general(a, s)
+    real(wp), intent(in) :: a(3)     !! axial vector of ½ΔtW
+    real(wp), intent(inout) :: s(6)  !! Cauchy stress, Voigt [Pa]
+    real(wp) :: c, Q(3,3), S3(3,3), T(3,3), M(3,3)
+    integer :: i, j
     ! Q = I + 2/(1 + a·a) (A + A²), with A² = a aᵀ − (a·a) I.
     c = 2.0_wp / (1.0_wp + a(1)**2 + a(2)**2 + a(3)**2)
     do j = 1, 3
@@ -81,11 +89,11 @@ contains
     s(4) = 0.5_wp * (T(2,3) + T(3,2))
     s(5) = 0.5_wp * (T(1,3) + T(3,1))
     s(6) = 0.5_wp * (T(1,2) + T(2,1))
-  end subroutine jaumann_rotate
+  end subroutine rotate_general
 
   !> [[jaumann_rotate]] for a spin about z alone (every 2D step), a3 = ¼Δt(L21 − L12): Q is
   !> the in-plane rotation cos = 1 − c a3², sin = c a3, c = 2/(1 + a3²) (the general Q,
-  !> written out: a quarter of the 3×3 products). Small, so that callers inline it.
+  !> written out: a quarter of the 3×3 products).
   pure subroutine rotate_about_z(a3, s)
     real(wp), intent(in) :: a3       !! axial vector's z component of ½ΔtW
     real(wp), intent(inout) :: s(6)  !! Cauchy stress, Voigt [Pa]
@@ -104,8 +112,8 @@ contains
   !> [[jaumann_rotate]] of the stresses s(:, p) of particles 1..n with the velocity gradients
   !> L(:, :, p), skipping those whose step would invert them, 1 + Δt tr L ≤ 0 (tr L summed as
   !> [[strain_increment]]'s diagonal is: the models update no stress there). For a model that
-  !> rotates before its increment: one call per block instead of one per particle, the
-  !> rotation inlined into this loop.
+  !> rotates before its increment: one call per block instead of one per particle (the
+  !> rotation, split into its two cases, is inlined into this loop).
   pure subroutine jaumann_rotate_block(dt, n, L, s)
     real(wp), intent(in) :: dt           !! time step [s]
     integer, intent(in) :: n             !! number of particles
@@ -114,13 +122,7 @@ contains
     integer :: p
     do p = 1, n
       if (1.0_wp + (dt * L(1,1,p) + dt * L(2,2,p) + dt * L(3,3,p)) <= 0.0_wp) cycle
-      ! The axial vector as jaumann_rotate forms it; the 2D case without the call.
-      if (0.25_wp * dt * (L(3,2,p) - L(2,3,p)) == 0.0_wp .and. &
-          0.25_wp * dt * (L(1,3,p) - L(3,1,p)) == 0.0_wp) then
-        call rotate_about_z(0.25_wp * dt * (L(2,1,p) - L(1,2,p)), s(:,p))
-      else
-        call jaumann_rotate(dt, L(:,:,p), s(:,p))
-      end if
+      call jaumann_rotate(dt, L(:,:,p), s(:,p))
     end do
   end subroutine jaumann_rotate_block
 
