@@ -15,7 +15,7 @@ module empm_shape_linear
   use empm_shape, only: empm_shape_t, empm_basis_t, SHAPE_OK, SHAPE_OUTSIDE_GRID, &
                         SHAPE_SUPPORT_CLIPPED, SHAPE_TOO_MANY_NODES, SHAPE_BAD_LAYOUT, SHAPE_NO_MEMORY, &
                         BASIS_LISTS, BASIS_Q4, BASIS_Q8, BASIS_G9, BASIS_G27, basis_q4_weights, &
-                        basis_stencil_factors
+                        basis_q8_weights, basis_stencil_factors
   implicit none
   private
   public :: empm_shape_linear_t, shape_linear_kernel
@@ -249,9 +249,10 @@ contains
 
   !> Trilinear values and gradients at particles p0..p1 into node lists: the bits of
   !> [[shape_linear_kernel]] (its cell, clamps and the products of [[shape_tp_assemble]], in
-  !> its node order, x fastest) without the per-point work arrays and run-time dimension. A
-  !> particle outside the closed grid box gets nn = 0; `ibad` is the first one, huge(1) if
-  !> none.
+  !> its node order, x fastest) without the per-point work arrays and run-time dimension;
+  !> located by [[q8_range]], values by [[basis_q8_weights]], as for the compact layout (one
+  !> text for both layouts, as [[linear_range_2d]] has in 2D). A particle outside the closed
+  !> grid box gets nn = 0; `ibad` is the first one, huge(1) if none.
   pure subroutine linear_range_3d(grid, p0, p1, x, mx, nn, node, N, dN, ibad)
     type(empm_grid_t), intent(in) :: grid    !! background grid (3D)
     integer, intent(in) :: p0                !! first particle
@@ -263,45 +264,27 @@ contains
     real(wp), intent(inout) :: N(mx, *)      !! values
     real(wp), intent(inout) :: dN(3, mx, *)  !! gradients
     integer, intent(out) :: ibad             !! first particle outside the grid, huge(1) if none
-    real(wp) :: w(2, 3), g(2, 3), e(3), s, t, w23
-    integer :: p, d, i0(3), k1, k2, k3, a, row, n1, n12
+    real(wp) :: t(3, 1)
+    integer :: p, id(1), n1, n12, b, a1, a2, a3
     n1 = grid%ln(1); n12 = grid%ln(1) * grid%ln(2)
-    do d = 1, 3
-      e(d) = grid%origin(d) + grid%ncell(d) * grid%h(d) ! grid%inside's upper faces
-      g(1, d) = -grid%inv_h(d); g(2, d) = grid%inv_h(d)
-    end do
     ibad = huge(1)
     do p = p0, p1
-      if (.not. (x(1, p) >= grid%origin(1) .and. x(1, p) <= e(1) .and. &
-                 x(2, p) >= grid%origin(2) .and. x(2, p) <= e(2) .and. &
-                 x(3, p) >= grid%origin(3) .and. x(3, p) <= e(3))) then
+      ! Located as for the compact layout (one particle: x(1, p) starts its coordinates).
+      call q8_range(grid, 1, 1, x(1, p), id, t, b)
+      if (b /= huge(1)) then
         nn(p) = 0
         ibad = min(ibad, p)
         cycle
       end if
-      do d = 1, 3
-        s = (x(d, p) - grid%origin(d)) * grid%inv_h(d)
-        i0(d) = min(max(floor(s), 0), grid%ncell(d) - 1)
-        t = min(max(s - i0(d), 0.0_wp), 1.0_wp)
-        w(1, d) = 1.0_wp - t
-        w(2, d) = t
-      end do
-      a = 0
-      do k3 = 1, 2
-        do k2 = 1, 2
-          w23 = w(k2, 2) * w(k3, 3)
-          row = grid%id0 + i0(1) + n1 * (i0(2) + k2 - 1) + n12 * (i0(3) + k3 - 1)
-          do k1 = 1, 2
-            a = a + 1
-            node(a, p) = row + k1 - 1
-            N(a, p) = w(k1, 1) * w23
-            dN(1, a, p) = g(k1, 1) * w23
-            dN(2, a, p) = g(k2, 2) * (w(k1, 1) * w(k3, 3))
-            dN(3, a, p) = g(k3, 3) * (w(k1, 1) * w(k2, 2))
+      nn(p) = 8
+      do a3 = 0, 1
+        do a2 = 0, 1
+          do a1 = 0, 1
+            node(1 + a1 + 2 * a2 + 4 * a3, p) = id(1) + a1 + n1 * a2 + n12 * a3
           end do
         end do
       end do
-      nn(p) = 8
+      call basis_q8_weights(t(:, 1), grid%inv_h(1:3), N(1:8, p), dN(1:3, 1:8, p))
     end do
   end subroutine linear_range_3d
 
