@@ -440,10 +440,12 @@ contains
   end subroutine zero
 
   !> Constrain components `comp` of every node inside the closed box [lo, hi] (a node set by
-  !> geometry) to the velocity `value`. Returns the number of nodes selected. Allocates the
-  !> nodal storage on first use. With `name`, the dofs fixed here also form a reaction set
-  !> of that name, whose reaction force [[nodes_compute_reactions]] records.
-  subroutine nodes_fix_box(self, grid, lo, hi, comp, value, nsel, name)
+  !> geometry) to the velocity `value`, or with `gradient` G to the affine field
+  !> value + G x_I (x_I the node's position: a kinematic driver, steady in space). Returns the
+  !> number of nodes selected. Allocates the nodal storage on first use. With `name`, the dofs
+  !> fixed here also form a reaction set of that name, whose reaction force
+  !> [[nodes_compute_reactions]] records (uniform `value` only).
+  subroutine nodes_fix_box(self, grid, lo, hi, comp, value, nsel, name, gradient)
     class(empm_nodes_t), intent(inout) :: self !! nodal fields
     type(empm_grid_t), intent(in) :: grid      !! background grid
     real(wp), intent(in) :: lo(3)              !! lower corner of the selection box [m]
@@ -452,7 +454,9 @@ contains
     real(wp), intent(in) :: value(3)           !! prescribed velocity components [m/s]
     integer, intent(out) :: nsel               !! number of nodes selected
     character(len=*), intent(in), optional :: name !! name of the reaction set to record
-    real(wp) :: tol
+    real(wp), intent(in), optional :: gradient(3, 3) !! velocity gradient G of the prescribed
+                                                     !! field value + G x [1/s]
+    real(wp) :: tol, x(3), v(3)
     integer :: q, id, d, nd, nc, j
     integer, allocatable :: ids(:), dofs(:)
     real(wp), allocatable :: vals(:)
@@ -466,12 +470,17 @@ contains
     j = 0
     do q = 1, nsel
       id = ids(q)
+      v = value
+      if (present(gradient)) then
+        x = grid%node_coord(id)
+        v = value + matmul(gradient, x)
+      end if
       do d = 1, nd
         if (comp(d)) then
-          j = j + 1; dofs(j) = d + nd * (id - 1); vals(j) = value(d)
+          j = j + 1; dofs(j) = d + nd * (id - 1); vals(j) = v(d)
           if (.not. self%sparse) then
             self%fixed(d, id) = .true.
-            self%vfix(d, id) = value(d)
+            self%vfix(d, id) = v(d)
           end if
         end if
       end do

@@ -794,6 +794,73 @@ contains
     end select
   end subroutine trapezoid_gradient
 
+  !> L := L (I + ½Δt L)⁻¹ for particle `p`: the midpoint gradient G/Δt of the trapezoidal
+  !> drift's increment ΔF = I + ΔtL, G = (ΔF − I)(½(I + ΔF))⁻¹, that a rate-form model takes
+  !> (`ctx%midpoint`, [[empm_plasticity]]): Δt sym G is the step's strain to second order and
+  !> is zero under a rigid rotation, whose Cayley transform of Δt skw G is that rotation.
+  !> `ok` is false, and L zero, when I + ½ΔtL is singular or reverses orientation (ΔF inverts
+  !> the particle).
+  pure subroutine midpoint_gradient(dt, d, L, ok)
+    real(wp), intent(in) :: dt             !! time step [s]
+    integer, intent(in) :: d               !! dimension (the d × d part of L is used)
+    real(wp), intent(inout) :: L(3, 3)     !! trapezoidal gradient in, midpoint gradient out
+    logical, intent(out) :: ok             !! the increment is invertible
+    real(wp) :: h, M(3, 3), C(3, 3), det
+    integer :: i, j
+    h = 0.5_wp * dt
+    select case (d)
+    case (1)
+      det = 1.0_wp + h * L(1, 1)
+      ok = det > 0.0_wp
+      if (ok) then
+        L(1, 1) = L(1, 1) / det
+      else
+        L(1, 1) = 0.0_wp
+      end if
+    case (2)
+      M(1, 1) = 1.0_wp + h * L(1, 1); M(1, 2) = h * L(1, 2)
+      M(2, 1) = h * L(2, 1); M(2, 2) = 1.0_wp + h * L(2, 2)
+      det = M(1, 1) * M(2, 2) - M(1, 2) * M(2, 1)
+      ok = det > 0.0_wp
+      if (.not. ok) then
+        L(1:2, 1:2) = 0.0_wp; return
+      end if
+      ! L M⁻¹ with M⁻¹ = adj(M)/det.
+      C(1, 1) = L(1, 1) * M(2, 2) - L(1, 2) * M(2, 1)
+      C(1, 2) = L(1, 2) * M(1, 1) - L(1, 1) * M(1, 2)
+      C(2, 1) = L(2, 1) * M(2, 2) - L(2, 2) * M(2, 1)
+      C(2, 2) = L(2, 2) * M(1, 1) - L(2, 1) * M(1, 2)
+      L(1:2, 1:2) = C(1:2, 1:2) / det
+    case default
+      do j = 1, 3
+        do i = 1, 3
+          M(i, j) = h * L(i, j)
+        end do
+        M(j, j) = M(j, j) + 1.0_wp
+      end do
+      C(1, 1) = M(2, 2) * M(3, 3) - M(2, 3) * M(3, 2)
+      C(1, 2) = M(1, 3) * M(3, 2) - M(1, 2) * M(3, 3)
+      C(1, 3) = M(1, 2) * M(2, 3) - M(1, 3) * M(2, 2)
+      C(2, 1) = M(2, 3) * M(3, 1) - M(2, 1) * M(3, 3)
+      C(2, 2) = M(1, 1) * M(3, 3) - M(1, 3) * M(3, 1)
+      C(2, 3) = M(1, 3) * M(2, 1) - M(1, 1) * M(2, 3)
+      C(3, 1) = M(2, 1) * M(3, 2) - M(2, 2) * M(3, 1)
+      C(3, 2) = M(1, 2) * M(3, 1) - M(1, 1) * M(3, 2)
+      C(3, 3) = M(1, 1) * M(2, 2) - M(1, 2) * M(2, 1)
+      det = M(1, 1) * C(1, 1) + M(1, 2) * C(2, 1) + M(1, 3) * C(3, 1)
+      ok = det > 0.0_wp
+      if (.not. ok) then
+        L = 0.0_wp; return
+      end if
+      do j = 1, 3
+        do i = 1, 3
+          M(i, j) = (L(i, 1) * C(1, j) + L(i, 2) * C(2, j) + L(i, 3) * C(3, j)) / det
+        end do
+      end do
+      L = M
+    end select
+  end subroutine midpoint_gradient
+
   !> Nodal averaging of the volumetric strain rate (a B-bar/F-bar-like projection for MPM):
   !> ē_I = Σ_p N_Ip m_p tr L_p / Σ_p N_Ip m_p on every node with mass, then
   !> ē_p = Σ_I N_Ip ē_I. One volumetric constraint per node instead of one per particle, which
@@ -809,13 +876,17 @@ contains
     real(wp), intent(in) :: dt                       !! time step [s]
     real(wp) :: Lb(3, 3, STRESS_BLOCK)
     integer :: np, d, nc, c, a, b, q0, q1, p, k, I
-    logical :: tz
+    logical :: tz, rf(size(model%mats)), ok
     np = model%pts%np; d = model%grid%ndim
     nc = empm_chunks(np)
     tz = size(lprev) > 0
+    ! The trace the stress update will see: of the midpoint gradient for a rate-form model.
+    do k = 1, size(rf)
+      rf(k) = tz .and. model%mats(k)%model%rate_form()
+    end do
     !$omp parallel do default(none) schedule(static, 1) &
-    !$omp& shared(model, vel, integ, np, nc, d, lprev, dt, tz) &
-    !$omp& private(a, b, q0, q1, p, k, Lb) if(nc > 1)
+    !$omp& shared(model, vel, integ, np, nc, d, lprev, dt, tz, rf) &
+    !$omp& private(a, b, q0, q1, p, k, Lb, ok) if(nc > 1)
     do c = 0, nc - 1
       call empm_chunk_bounds(np, nc, c, a, b)
       Lb = 0.0_wp
@@ -823,6 +894,9 @@ contains
         q1 = min(b, q0 + STRESS_BLOCK - 1)
         call velocity_gradient(model%basis, vel, q0, q1, Lb)
         if (tz) call trapezoid_gradient(dt, lprev(:, :, q0:q1), Lb)
+        do p = q0, q1
+          if (rf(model%pts%mat(p))) call midpoint_gradient(dt, d, Lb(:, :, p - q0 + 1), ok)
+        end do
         do p = q0, q1
           integ%vs_tr(p) = 0.0_wp
           do k = 1, d
@@ -874,7 +948,7 @@ contains
     real(wp), intent(in) :: cx
     real(wp) :: Lb(3, 3, STRESS_BLOCK), dv, cm
     integer :: r, i0, i1, info, im, n, nc, c, a, b, q0, q1, bad, p, k, g0
-    logical :: fine, we, ok
+    logical :: fine, we, ok, mp
     type(empm_material_ctx_t) :: ctx
     ctx%t = model%t; ctx%step = model%step + 1; ctx%ndim = model%grid%ndim
     ctx%h = minval(model%grid%h(1:model%grid%ndim))
@@ -890,10 +964,13 @@ contains
       im = model%pts%mat(i0)
       n = i1 - i0 + 1
       nc = empm_chunks(n)
+      ! The trapezoidal drift gives a rate-form model its midpoint gradient.
+      mp = tz .and. model%mats(im)%model%rate_form()
+      ctx%midpoint = mp
       ! The first failing particle of the run, whichever block it is in.
       bad = huge(1)
       !$omp parallel do default(none) schedule(static, 1) &
-      !$omp& shared(model, vel, dt, i0, im, n, nc, sm, tr, bar, tz, lprev, we, cx) &
+      !$omp& shared(model, vel, dt, i0, im, n, nc, sm, tr, bar, tz, lprev, we, cx, mp) &
       !$omp& private(a, b, q0, q1, p, k, dv, Lb, info, ok, g0) firstprivate(ctx) &
       !$omp& reduction(min: bad) reduction(.and.: fine) reduction(max: cm) if(nc > 1)
       do c = 0, nc - 1
@@ -911,6 +988,12 @@ contains
             call half_back(q0, q1, model%pts%x, model%pts%dx)
             call gradient_g2p_block(model%basis, vel, q0, q1, Lb, 0.5_wp * dt, model%pts%dx)
             call trapezoid_gradient(dt, lprev(:, :, q0:q1), Lb)
+            if (mp) then
+              do p = q0, q1
+                call midpoint_gradient(dt, ctx%ndim, Lb(:, :, p - q0 + 1), ok)
+                if (.not. ok) bad = min(bad, p)
+              end do
+            end if
           else if (cx /= 0.0_wp) then
             call gradient_g2p_block(model%basis, vel, q0, q1, Lb, cx, model%pts%x)
           else

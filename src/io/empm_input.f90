@@ -168,7 +168,11 @@ contains
           'docs/input.md)', lo=0.0_wp, hi=90.0_wp, hi_open=.true., optional=.true.), &
         empm_param('normal', PARAM_STR, '-', 'with friction_angle: the direction from the '// &
           'wall into the body (''+y'' for a base under it)', optional=.true., &
-          choices='-x +x -y +y -z +z')]
+          choices='-x +x -y +y -z +z'), &
+        empm_param('velocity_gradient', PARAM_REAL, '1/s', 'a kinematic driver: the fixed '// &
+          'components get velocity + G x_I at each node x_I (G given row by row, ndim x ndim '// &
+          'values; steady in space and time: rigid rotation, simple shear, triaxial paths)', &
+          count=9, lo=-LMAX, hi=LMAX, optional=.true.)]
     case ('traction')
       p = [ &
         empm_param('name', PARAM_STR, '-', 'label (messages)', optional=.true.), &
@@ -941,9 +945,9 @@ contains
     type(empm_error_t), intent(inout) :: e
     type(empm_param_t), allocatable :: p(:)
     type(empm_group_t) :: g
-    real(wp) :: lo(3), hi(3), velocity(3)
+    real(wp) :: lo(3), hi(3), velocity(3), gv(9), grad(3, 3)
     logical :: fix(3)
-    integer :: nb, nsel, nd, k, nlo, nhi, n
+    integer :: nb, nsel, nd, k, nlo, nhi, n, ng, i
     character(len=:), allocatable :: name, mirror
     allocate(p, source=empm_input_group_params('boundary'))
     nd = cs%model%grid%ndim
@@ -986,6 +990,30 @@ contains
         call g%fail(e, 'fix', 'expected at least one .true. component (boundary '//str(nb)//')')
         return
       end if
+      if (g%has('velocity_gradient')) then
+        gv = 0.0_wp
+        call g%get(p(9), gv, ng, e)
+        if (e%code /= EMPM_OK) return
+        if (ng /= nd * nd) then
+          call g%fail(e, 'velocity_gradient', 'expected ndim x ndim = '//str(nd * nd)// &
+            ' values, row by row, got '//str(ng)//' (boundary '//str(nb)//')'); return
+        end if
+        if (mirror /= 'none' .or. g%has('name')) then
+          call g%fail(e, 'velocity_gradient', 'not with '//trim(merge('mirror', 'name  ', &
+            mirror /= 'none'))//': a kinematic driver is neither a mirror plane nor a '// &
+            'reaction set (boundary '//str(nb)//')'); return
+        end if
+        grad = 0.0_wp
+        do i = 1, nd
+          grad(i, 1:nd) = gv((i - 1) * nd + 1:i * nd)
+        end do
+        call cs%model%nodes%fix_box(cs%model%grid, lo, hi, fix, velocity, nsel, gradient=grad)
+        if (nsel == 0) then
+          call g%fail(e, 'lo', 'the box [lo, hi] selects no grid node (boundary '//str(nb)// &
+            '): nodes lie at origin + i*h'); return
+        end if
+        cycle
+      end if
       if (mirror /= 'none') then
         call read_mirror(g, cs, lo, hi, fix, velocity, trim(mirror), nb, e)
         if (e%code /= EMPM_OK) return
@@ -1014,7 +1042,8 @@ contains
     type(empm_error_t), intent(inout) :: e
     real(wp), parameter :: DEG = acos(-1.0_wp) / 180.0_wp
     character(len=:), allocatable :: normal
-    character(len=*), parameter :: KEYS(3) = [character(len=8) :: 'fix', 'velocity', 'mirror']
+    character(len=*), parameter :: KEYS(4) = [character(len=17) :: 'fix', 'velocity', 'mirror', &
+      'velocity_gradient']
     real(wp) :: delta
     integer :: a, side, k, nsel, info
     if (.not. g%has('friction_angle') .or. .not. g%has('normal')) then

@@ -41,6 +41,10 @@ module empm_material
                             !! any number of processes; a user subroutine's element number)
     integer :: ndim = 3     !! spatial dimension of the model (1, 2 or 3)
     real(wp) :: h = 0.0_wp  !! smallest grid spacing [m] (0 when there is no grid)
+    logical :: midpoint = .false. !! the kinematics' form: .false., the increment of F is
+                            !! I + ΔtL; .true. (`pc_newmark`, `gen_alpha` for a `rate_form`
+                            !! model), L is the midpoint gradient and the increment is
+                            !! (I − ½ΔtL)⁻¹(I + ½ΔtL) ([[empm_plasticity]])
   end type empm_material_ctx_t
 
   !> Abstract material.
@@ -57,6 +61,7 @@ module empm_material
     procedure :: init_state => material_init_state
     procedure :: failure_text => material_failure_text
     procedure :: max_wave_speed => material_max_wave_speed
+    procedure :: rate_form => material_rate_form
   end type empm_material_t
 
   abstract interface
@@ -162,6 +167,17 @@ contains
     associate (unused_ => stress, unused2_ => state); end associate
     c = self%wave_speed(minval(rho))
   end function material_max_wave_speed
+
+  !> Whether the model is rate-form (its increments are Δt sym L and a rotation by Δt skw L:
+  !> hypoelastic and return-mapping models; the default) rather than F-based (a hyperelastic
+  !> model that advances F with I + ΔtL). A scheme whose increment of F is not I + ΔtL for
+  !> any L (the trapezoidal drift) gives a rate-form model the midpoint gradient instead,
+  !> `ctx%midpoint` set, and an F-based one the L of the exact increment.
+  pure logical function material_rate_form(self) result(r)
+    class(empm_material_t), intent(in) :: self !! material
+    associate (unused_ => self); end associate
+    r = .true.
+  end function material_rate_form
 
   !> Why `update` reported a particle as failed (`info = k > 0`), for the run's error message.
   !> The default is the kinematic failure every model shares; a model that can fail otherwise

@@ -3,7 +3,9 @@
 !>
 !> Compression-positive invariants: p' = −tr σ/3, q = √(3J₂), s = dev σ (σ tension positive).
 !> Specific volume v = 1 + e, tracked exactly from the volumetric strain: v ← v exp(tr Δε)
-!> (so ρ v stays constant: ρ ← ρ exp(−tr Δε)).
+!> (so ρ v stays constant: ρ ← ρ exp(−tr Δε)). The stress is rotated with the step's spin
+!> ([[jaumann_rotate]]) and Δε turned by half of it ([[corotated_increment]]), so that the
+!> Jaumann rate is integrated to second order under any motion.
 !>
 !> - Yield: f = q²/M² + p'(p' − p'c) ≤ 0; associated flow Δεᵖ = Δγ ∂f/∂σ.
 !> - Elasticity: K = v p'/κ, written in the exact "κ-line" form ln(p'/p'ₙ) = −Δvᵉ/κ (v dεᵉ_vol =
@@ -38,7 +40,7 @@ module empm_material_camclay
   use empm_params, only: empm_param_t, empm_param, PARAM_REAL
   use empm_namelist, only: empm_group_t
   use empm_material, only: empm_material_t, empm_material_ctx_t, STATE_NAME_LEN
-  use empm_plasticity, only: strain_increment, jaumann_rotate, mean_deviator
+  use empm_plasticity, only: corotated_increment, jaumann_rotate, mean_deviator, volume_ratio
   implicit none
   private
   public :: empm_camclay_t, camclay_stats_t
@@ -313,13 +315,12 @@ contains
     real(wp), intent(inout), contiguous :: stress(:,:) !! Cauchy stress, Voigt (6,n) [Pa]
     real(wp), intent(inout), contiguous :: state(:,:)  !! pc, v, resolved (rows 1..3)
     real(wp), intent(inout), contiguous :: rho(:)      !! density (n) [kg/m³]
-    type(empm_material_ctx_t), intent(in) :: ctx     !! unused
+    type(empm_material_ctx_t), intent(in) :: ctx     !! the kinematics' form (`midpoint`)
     integer, intent(out) :: info                     !! 0 ok; k > 0 particle k failed; −1 shapes
-    real(wp) :: de(6), tr, sig(6), st(3)
+    real(wp) :: de(6), tr, sig(6), st(3), jv
     type(camclay_stats_t) :: stats
     integer :: p, n, status
     logical :: ok
-    associate (unused_ => ctx); end associate
     info = 0
     n = size(rho)
     if (size(L, 3) /= n .or. size(F, 3) /= n .or. size(strain, 2) /= n &
@@ -328,10 +329,12 @@ contains
       return
     end if
     do p = 1, n
-      de = strain_increment(dt, L(:,:,p))
+      de = corotated_increment(dt, L(:,:,p))
       tr = de(1) + de(2) + de(3)
       ! A volume ratio exp(tr) beyond e^±1 in one step is no soil increment: refuse it.
-      if (.not. (abs(tr) < 1.0_wp .and. 1.0_wp + tr > 0.0_wp)) then
+      jv = 1.0_wp + tr
+      if (ctx%midpoint) jv = volume_ratio(dt, L(:,:,p), .true.)
+      if (.not. (abs(tr) < 1.0_wp .and. jv > 0.0_wp)) then
         if (info == 0) info = p
         call record(WHY_VOLUME, stress(:,p), state(1,p), tr)
         cycle
@@ -355,6 +358,8 @@ contains
       strain(:,p) = strain(:,p) + de
       stress(:,p) = sig
       state(1:3,p) = st
+      ! exp(tr Δε), as the specific volume's update: det ΔF to O(Δt³) with either kinematics
+      ! (with the midpoint form, log det ΔF = tr ΔtL + O(Δt³)).
       rho(p) = rho(p) * fexp(-tr)
     end do
   contains

@@ -11,7 +11,8 @@
 !> (triaxial compression) or at the inner (triaxial extension) corners, chosen by `match`.
 !> The apex of the cone lies at m_A = ξc/η; the cut-off T defaults to it and may not exceed it.
 !>
-!> Step: Δε = Δt·sym(L), σ ← Q σ Qᵀ ([[jaumann_rotate]]), trial σᵗʳ = σ + K tr Δε I + 2G dev Δε.
+!> Step: Δε = Δt·sym(L) turned by half the step's rotation ([[corotated_increment]]),
+!> σ ← Q σ Qᵀ ([[jaumann_rotate]]), trial σᵗʳ = σ + K tr Δε I + 2G dev Δε.
 !> If f(σᵗʳ) ≤ 0 and mᵗʳ ≤ T the step is elastic (the common case, checked first). Otherwise
 !> the return is found in closed form in the (m, t) plane, the deviator keeping its direction:
 !> - cone:    Δλ = f(σᵗʳ)/(G + K η η_ψ), t = tᵗʳ − GΔλ, m = mᵗʳ − K η_ψ Δλ, valid when t ≥ 0
@@ -37,7 +38,7 @@ module empm_material_drucker_prager
   use empm_namelist, only: empm_group_t
   use empm_material, only: empm_material_t, empm_material_ctx_t, STATE_NAME_LEN
   use empm_material_linear_elastic, only: empm_elastic_params, empm_elastic_read, empm_lame
-  use empm_plasticity, only: jaumann_rotate
+  use empm_plasticity, only: jaumann_rotate, corotated_increment, volume_ratio
   implicit none
   private
   public :: empm_drucker_prager_t, empm_dp_match, empm_dp_return, empm_dp_tangent
@@ -362,11 +363,10 @@ contains
     real(wp), intent(inout), contiguous :: stress(:,:)     !! Cauchy stress, Voigt (6,n) [Pa]
     real(wp), intent(inout), contiguous :: state(:,:)      !! eps_p_eq, eps_p_vol (rows 1, 2)
     real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
-    type(empm_material_ctx_t), intent(in) :: ctx     !! unused
+    type(empm_material_ctx_t), intent(in) :: ctx     !! the kinematics' form (`midpoint`)
     integer, intent(out) :: info                     !! 0 ok; k > 0 particle k failed; −1 shapes
-    real(wp) :: de(6), tr, sig(6), m_tr, t_tr, m, t
+    real(wp) :: de(6), tr, sig(6), m_tr, t_tr, m, t, jv
     integer :: p, n, region
-    associate (unused_ => ctx); end associate
     info = 0
     n = size(rho)
     if (size(L, 3) /= n .or. size(F, 3) /= n .or. size(strain, 2) /= n &
@@ -375,14 +375,10 @@ contains
       return
     end if
     do p = 1, n
-      de(1) = dt * L(1,1,p)
-      de(2) = dt * L(2,2,p)
-      de(3) = dt * L(3,3,p)
-      de(4) = 0.5_wp * dt * (L(2,3,p) + L(3,2,p))
-      de(5) = 0.5_wp * dt * (L(1,3,p) + L(3,1,p))
-      de(6) = 0.5_wp * dt * (L(1,2,p) + L(2,1,p))
+      de = corotated_increment(dt, L(:,:,p))
       tr = de(1) + de(2) + de(3)
-      if (1.0_wp + tr <= 0.0_wp) then
+      jv = volume_ratio(dt, L(:,:,p), ctx%midpoint)
+      if (jv <= 0.0_wp) then
         if (info == 0) info = p
         cycle
       end if
@@ -390,7 +386,7 @@ contains
       call jaumann_rotate(dt, L(:,:,p), stress(:,p))
       if (self%substep_tol > 0.0_wp) then
         call dp_integrate(self, stress(:,p), de, state(1,p), state(2,p))
-        rho(p) = rho(p) / (1.0_wp + tr)
+        rho(p) = rho(p) / jv
         cycle
       end if
       ! The elastic predictor in linear_elastic's operation order: with an unreachable
@@ -402,7 +398,7 @@ contains
         state(1,p) = state(1,p) + (t_tr - t) / (sqrt(3.0_wp) * self%G)
         state(2,p) = state(2,p) + (m_tr - m) / self%K
       end if
-      rho(p) = rho(p) / (1.0_wp + tr)
+      rho(p) = rho(p) / jv
     end do
   end subroutine dp_update
 

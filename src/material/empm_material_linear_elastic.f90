@@ -1,9 +1,11 @@
 !> Isotropic linear elasticity, hypoelastic update (paper eqs. 2–4, 18–19), objective by default.
 !>
 !> Each step: Δε = Δt·sym(L), ε ← ε + Δε, σ ← σ + D:Δε with the isotropic D (Lamé λ, μ),
-!> ρ ← ρ/(1 + tr Δε) (eq. 19). With `rate = 'jaumann'` (the default) the stress is first
+!> ρ ← ρ/(1 + tr Δε) (eq. 19; ρ/det ΔF with the midpoint kinematics of `pc_newmark` and
+!> `gen_alpha`, [[volume_ratio]]). With `rate = 'jaumann'` (the default) the stress is first
 !> rotated with the spin of the step (σ ← QσQᵀ, Q the orthogonal Cayley rotation of ΔtW,
-!> [[jaumann_rotate]]), so that a body in rigid rotation carries its stress with it;
+!> [[jaumann_rotate]]), so that a body in rigid rotation carries its stress with it, and Δε is
+!> turned by half that rotation ([[corotated_increment]]: second order under strain with spin);
 !> `rate = 'small_strain'` is the paper's update, which omits the rotation. The two agree
 !> wherever W = 0 (always in 1D). 1D uniaxial strain and 2D plane strain need no special case:
 !> the velocity gradient is zero in the unused directions, so the lateral stresses come out
@@ -20,7 +22,8 @@ module empm_material_linear_elastic
   use empm_params, only: empm_param_t, empm_param, PARAM_REAL, PARAM_STR
   use empm_namelist, only: empm_group_t
   use empm_material, only: empm_material_t, empm_material_ctx_t
-  use empm_plasticity, only: jaumann_rotate_block
+  use empm_plasticity, only: jaumann_rotate_block, volume_ratio, strain_increment, &
+    corotated_increment
   implicit none
   private
   public :: empm_linear_elastic_t, empm_elastic_check, empm_lame
@@ -206,11 +209,11 @@ contains
     real(wp), intent(inout), contiguous :: stress(:,:)     !! Cauchy stress, Voigt (6,n) [Pa]
     real(wp), intent(inout), contiguous :: state(:,:)      !! state variables, none used
     real(wp), intent(inout), contiguous :: rho(:)          !! density (n) [kg/m³]
-    type(empm_material_ctx_t), intent(in) :: ctx     !! unused
+    type(empm_material_ctx_t), intent(in) :: ctx     !! the kinematics' form (`midpoint`)
     integer, intent(out) :: info                     !! 0 ok; k > 0 particle k failed; −1 shapes
-    real(wp) :: de(6), tr
+    real(wp) :: de(6), tr, jv
     integer :: p, n
-    associate (unused_ => state, unused2_ => ctx); end associate
+    associate (unused_ => state); end associate
     info = 0
     n = size(rho)
     if (size(L, 3) /= n .or. size(F, 3) /= n .or. size(strain, 2) /= n &
@@ -220,24 +223,29 @@ contains
     end if
     ! The rotation of the start-of-step stresses first, for the block (a call per particle
     ! cost as much as the rotation); the particles the loop below rejects are not rotated.
-    if (self%jaumann) call jaumann_rotate_block(dt, n, L, stress)
+    ! The Jaumann increment is then the corotated one (second order under strain with spin).
+    if (self%jaumann) call jaumann_rotate_block(dt, n, L, stress, ctx%midpoint)
     do p = 1, n
-      de(1) = dt * L(1,1,p)
-      de(2) = dt * L(2,2,p)
-      de(3) = dt * L(3,3,p)
-      de(4) = 0.5_wp * dt * (L(2,3,p) + L(3,2,p))
-      de(5) = 0.5_wp * dt * (L(1,3,p) + L(3,1,p))
-      de(6) = 0.5_wp * dt * (L(1,2,p) + L(2,1,p))
-      tr = de(1) + de(2) + de(3)
+      if (ctx%midpoint) then
+        jv = volume_ratio(dt, L(:,:,p), .true.)
+      else
+        jv = 1.0_wp + (dt * L(1,1,p) + dt * L(2,2,p) + dt * L(3,3,p))
+      end if
       ! eq. (19) integrated over the step; a non-positive volume ratio is unphysical.
-      if (1.0_wp + tr <= 0.0_wp) then
+      if (jv <= 0.0_wp) then
         if (info == 0) info = p
         cycle
       end if
+      if (self%jaumann) then
+        de = corotated_increment(dt, L(:,:,p))
+      else
+        de = strain_increment(dt, L(:,:,p))
+      end if
+      tr = de(1) + de(2) + de(3)
       strain(:,p) = strain(:,p) + de
       stress(1:3,p) = stress(1:3,p) + self%lambda * tr + 2.0_wp * self%mu * de(1:3)
       stress(4:6,p) = stress(4:6,p) + 2.0_wp * self%mu * de(4:6)
-      rho(p) = rho(p) / (1.0_wp + tr)
+      rho(p) = rho(p) / jv
     end do
   end subroutine le_update
 

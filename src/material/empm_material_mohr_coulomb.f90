@@ -7,9 +7,10 @@
 !>   f = (σ1 − σ3) + (σ1 + σ3) sin φ − 2c cos φ,   g = (σ1 − σ3) + (σ1 + σ3) sin ψ,
 !>
 !> and the tension cut-off σ1 ≤ σt (associated flow). Each step: Δε = Δt sym(L), Jaumann
-!> rotation of the stress ([[jaumann_rotate]]), elastic trial σ* = σ + D:Δε, its principal values
-!> and directions ([[principal_decompose]]; closed form in 2D), the return in principal space,
-!> and σ composed back with the trial's directions (isotropy: the return is coaxial with σ*).
+!> rotation of the stress ([[jaumann_rotate]]) with Δε turned by half of it
+!> ([[corotated_increment]]), elastic trial σ* = σ + D:Δε, its principal values and directions ([[principal_decompose]]; closed
+!> form in 2D), the return in principal space, and σ composed back with the trial's
+!> directions (isotropy: the return is coaxial with σ*).
 !>
 !> The return: every plane is linear in σ, so for a set A of active planes the return
 !> σ = σ* − Σ_{j∈A} Δλ_j D m_j (m_j the flow direction of plane j) solves the |A| linear
@@ -37,7 +38,8 @@ module empm_material_mohr_coulomb
   use empm_namelist, only: empm_group_t
   use empm_material, only: empm_material_t, empm_material_ctx_t, STATE_NAME_LEN
   use empm_material_linear_elastic, only: empm_elastic_params, empm_elastic_read, empm_lame
-  use empm_plasticity, only: jaumann_rotate, principal_decompose, principal_compose
+  use empm_plasticity, only: jaumann_rotate, corotated_increment, principal_decompose, &
+    principal_compose, volume_ratio
   implicit none
   private
   public :: empm_mohr_coulomb_t
@@ -854,11 +856,10 @@ contains
     real(wp), intent(inout), contiguous :: stress(:,:)    !! Cauchy stress, Voigt (6,n) [Pa]
     real(wp), intent(inout), contiguous :: state(:,:)     !! eps_p_shear, eps_p_vol (rows 1, 2)
     real(wp), intent(inout), contiguous :: rho(:)         !! density (n) [kg/m³]
-    type(empm_material_ctx_t), intent(in) :: ctx   !! unused
+    type(empm_material_ctx_t), intent(in) :: ctx   !! the kinematics' form (`midpoint`)
     integer, intent(out) :: info                   !! 0 ok; k > 0 particle k failed; −1 shapes
-    real(wp) :: de(6), tr
+    real(wp) :: de(6), tr, jv
     integer :: p, n, region, ip
-    associate (unused_ => ctx); end associate
     info = 0
     n = size(rho)
     if (size(L, 3) /= n .or. size(F, 3) /= n .or. size(strain, 2) /= n &
@@ -867,14 +868,10 @@ contains
       return
     end if
     do p = 1, n
-      de(1) = dt * L(1,1,p)
-      de(2) = dt * L(2,2,p)
-      de(3) = dt * L(3,3,p)
-      de(4) = 0.5_wp * dt * (L(2,3,p) + L(3,2,p))
-      de(5) = 0.5_wp * dt * (L(1,3,p) + L(3,1,p))
-      de(6) = 0.5_wp * dt * (L(1,2,p) + L(2,1,p))
+      de = corotated_increment(dt, L(:,:,p))
       tr = de(1) + de(2) + de(3)
-      if (1.0_wp + tr <= 0.0_wp) then
+      jv = volume_ratio(dt, L(:,:,p), ctx%midpoint)
+      if (jv <= 0.0_wp) then
         if (info == 0) info = p
         cycle
       end if
@@ -882,7 +879,7 @@ contains
       call jaumann_rotate(dt, L(:,:,p), stress(:,p))
       call mc_integrate(self, stress(:,p), de, state(1,p), state(2,p), region, ip)
       if (ip /= 0 .and. info == 0) info = p
-      rho(p) = rho(p) / (1.0_wp + tr)
+      rho(p) = rho(p) / jv
     end do
   end subroutine mc_update
 

@@ -38,6 +38,7 @@ module empm_material_neohookean
     procedure :: update => nh_update
     procedure :: wave_speed => nh_wave_speed
     procedure :: energy_density => nh_energy_density
+    procedure :: rate_form => nh_rate_form
   end type empm_neohookean_t
 
 contains
@@ -160,6 +161,13 @@ contains
       rho(p) = rho(p) * (J0 / J1)
     end do
   end subroutine nh_update
+
+  !> F-based, not rate-form: F advances with I + ΔtL ([[empm_material_t]]'s `rate_form`).
+  pure logical function nh_rate_form(self) result(r)
+    class(empm_neohookean_t), intent(in) :: self !! material
+    associate (unused_ => self); end associate
+    r = .false.
+  end function nh_rate_form
 
   !> Small-strain P-wave speed sqrt((λ + 2μ)/ρ) [m/s]. The tangent stiffness of this model
   !> stays close to λ + 2μ for moderate strains; for large compression the true speed is

@@ -9,9 +9,12 @@
 !> 2. converts to the Abaqus conventions: components 11, 22, 33, 12, 13, 23 (empm stores xx, yy,
 !>    zz, yz, xz, xy), engineering shear strains in STRAN and DSTRAN; 3D: NDI = 3, NSHR = 3;
 !>    2D plane strain and 1D uniaxial strain: NDI = 3, NSHR = 1 (in 1D the shears stay zero);
-!> 3. calls the UMAT with Δε = Δt sym(L), DFGRD0 = F at the start, DFGRD1 = F advanced with L
-!>    (F₁ = F₀ + Δt L F₀), TIME = t (step time = total time), DTIME = Δt, KSTEP = 1, KINC = the step
-!>    number, NOEL = the particle's id (generation order; the batch index when the caller gives
+!> 3. calls the UMAT with DSTRAN = Δt sym(L) turned by half the step's rotation (the native
+!>    models' increment, [[corotated_increment]]; as Abaqus, the increment of the midpoint
+!>    configuration seen in the end one), DFGRD0 = F at the start, DFGRD1 = F advanced with L
+!>    (F₁ = F₀ + Δt L F₀; with the midpoint form of `pc_newmark` and `gen_alpha`,
+!>    F₁ = (I − ½ΔtL)⁻¹(I + ½ΔtL) F₀, [[empm_plasticity]]), TIME = t (step time = total
+!>    time), DTIME = Δt, KSTEP = 1, KINC = the step number, NOEL = the particle's id (generation order; the batch index when the caller gives
 !>    no ids), NPT = LAYER = KSPT = 1, CELENT = the smallest grid spacing, COORDS = 0 (the
 !>    material interface carries no positions), TEMP = DTEMP = 0;
 !> 4. checks the result: a non-finite STRESS, a write past STATEV(NSTATV) (guard values after
@@ -20,7 +23,8 @@
 !>    equal sub-increments (k ≥ k_previous/PNEWDT and ≥ 2 k_previous, at most UMAT_MAX_SUB); a
 !>    particle whose step was cut adds 1 to its state variable `umat_cuts`.
 !>
-!> The density follows ρ ← ρ/(1 + tr Δε) as in the native rate-form models. State variables:
+!> The density follows ρ ← ρ/J with J the step's [[volume_ratio]], as in the native rate-form
+!> models. State variables:
 !> STATEV(1..NSTATV) as `statev1..statevN`, then SSE, SPD, SCD (carried between increments, as
 !> Abaqus does) as `umat_sse`, `umat_spd`, `umat_scd`, then `umat_cuts`. The stored energy
 !> density reported for the energy balance is SSE (energy per unit volume in the Abaqus
@@ -37,7 +41,7 @@ module empm_material_umat
   use empm_namelist, only: empm_group_t
   use empm_material, only: empm_material_t, empm_material_ctx_t, STATE_NAME_LEN
   use empm_material_linear_elastic, only: empm_lame
-  use empm_plasticity, only: strain_increment
+  use empm_plasticity, only: corotated_increment, volume_ratio, midpoint_increment
   use empm_dynlib, only: empm_dynlib_open, empm_dynlib_symbol
   use empm_files, only: empm_path_beside
   implicit none
@@ -426,6 +430,12 @@ contains
       d5 = hdt * (L(1,3,p) + L(3,1,p))
       d6 = hdt * (L(1,2,p) + L(2,1,p))
       vr(j) = 1.0_wp + (d1 + d2 + d3)
+      if (ctx%midpoint) vr(j) = volume_ratio(dt, L(:,:,p), .true.)
+      if (L(3,2,p) /= L(2,3,p) .or. L(1,3,p) /= L(3,1,p) .or. L(2,1,p) /= L(1,2,p)) then
+        ! With spin, Δε turned by half the step's rotation, as the native models' increment.
+        d = corotated_increment(dt, L(:,:,p))
+        d1 = d(1); d2 = d(2); d3 = d(3); d4 = d(4); d5 = d(5); d6 = d(6)
+      end if
       jac(j) = 1.0_wp
       if (ntens == 4 .and. L(3,2,p) == L(2,3,p) .and. L(1,3,p) == L(3,1,p)) then
         ! Plane strain and 1D (spin about z alone): the closed form of `rotate` written
@@ -471,7 +481,9 @@ contains
       end if
       ! DFGRD1: F advanced with L (DFGRD0 is the particle's F); or F unchanged, a copy
       ! passed as both (a careless UMAT writing to them does not change the particle's F).
-      if (rf) then
+      if (rf .and. ctx%midpoint) then
+        f1c(:,:,j) = matmul(midpoint_increment(dt, L(:,:,p)), F(:,:,p))
+      else if (rf) then
         call advance(a%ntens, dt, L(:,:,p), F(:,:,p), f1c(:,:,j))
       else
         f1c(:,:,j) = F(:,:,p)
@@ -540,12 +552,10 @@ contains
       pn = a%pnewdt
       k = min(UMAT_MAX_SUB, max(2, ceiling(1.0_wp / max(pn, 1.0_wp / UMAT_MAX_SUB))))
       ! Δε as in pass 1 (not from DSTRAN, which a careless UMAT may have changed)
-      d(1) = dt * L(1,1,p); d(2) = dt * L(2,2,p); d(3) = dt * L(3,3,p)
-      d(4) = hdt * (L(2,3,p) + L(3,2,p)); d(5) = hdt * (L(1,3,p) + L(3,1,p))
-      d(6) = hdt * (L(1,2,p) + L(2,1,p))
+      d = corotated_increment(dt, L(:,:,p))
       do
-        call increments(self, a, t, dt, L(:,:,p), d, stress(:,p), strain(:,p), F(:,:,p), &
-          state(1:nsv + NEXTRA, p), k, why, pn)
+        call increments(self, a, t, dt, L(:,:,p), d, ctx%midpoint, stress(:,p), strain(:,p), &
+          F(:,:,p), state(1:nsv + NEXTRA, p), k, why, pn)
         if (why /= WHY_PNEWDT .or. k >= UMAT_MAX_SUB) exit
         ! At least the ratio asked for, and at least twice as many as refused.
         k = min(UMAT_MAX_SUB, max(2 * k, &
@@ -676,10 +686,11 @@ contains
   ! every sub-increment succeeded (so a refusal or a failure leaves the particle as it was).
   ! why = 0 on success, else WHY_* (pnewdt then holds the UMAT's ratio when it refused).
   ! Explicit-shape dummies: the particle's values are then plain memory, not sections.
-  subroutine increments(self, a, t, dt, Lp, de, sp, ep, Fp, stp, k, why, pnewdt)
+  subroutine increments(self, a, t, dt, Lp, de, mid, sp, ep, Fp, stp, k, why, pnewdt)
     class(empm_umat_t), intent(in) :: self
     type(umat_args_t), intent(inout) :: a
     real(wp), intent(in) :: t, dt, Lp(3,3), de(6)
+    logical, intent(in) :: mid
     real(wp), intent(inout) :: sp(6), ep(6), Fp(3,3), stp(self%nstatv + NEXTRA)
     integer, intent(in) :: k
     integer, intent(out) :: why
@@ -695,7 +706,7 @@ contains
     if (k == 1) then
       dsub = de
     else
-      dsub = strain_increment(h, Lp)
+      dsub = corotated_increment(h, Lp)
     end if
     s = sp; e = ep; F0 = Fp
     do i = 1, nsv
@@ -709,7 +720,9 @@ contains
         call rotate(drot, s)
         if (self%uses_stran) call rotate(drot, e)
       end if
-      if (self%uses_dfgrd) then
+      if (self%uses_dfgrd .and. mid) then
+        F1 = matmul(midpoint_increment(h, Lp), F0)
+      else if (self%uses_dfgrd) then
         call advance(a%ntens, h, Lp, F0, F1)
       else
         F1 = F0

@@ -1,6 +1,15 @@
 !> Kernels shared by the rate-form (hypoelastic and elastoplastic) material models: the strain
-!> increment and the Jaumann rotation of a step, the isotropic elastic increment, stress
-!> invariants, and the spectral decomposition of a symmetric stress.
+!> increment, the volume ratio and the Jaumann rotation of a step, the isotropic elastic
+!> increment, stress invariants, and the spectral decomposition of a symmetric stress.
+!>
+!> The step's kinematics come in two forms ([[empm_material_ctx_t]]'s `midpoint`): with the
+!> Euler form the increment of F is I + ΔtL; with the midpoint form (the trapezoidal drift of
+!> `pc_newmark` and `gen_alpha`) L is the gradient on the step's midpoint configuration,
+!> G = ΔtL = (ΔF − I)(½(I + ΔF))⁻¹, so ΔF = (I − ½G)⁻¹(I + ½G) (Hughes and Winget 1980): a
+!> rigid rotation has sym G = 0 exactly and the Cayley rotation of skw G is that rotation.
+!> In either form a model rotates its stress with the step's spin and adds the increment of
+!> [[corotated_increment]] (Δε turned by half the rotation): the Jaumann rate is then
+!> integrated to second order whatever the motion, the order the scheme's kinematics allow.
 !>
 !> Conventions (those of empm): Voigt order (xx, yy, zz, yz, xz, xy) with tensor shears;
 !> tension positive. Soil models that think in compression-positive effective pressure convert
@@ -10,7 +19,7 @@ module empm_plasticity
   implicit none
   private
   public :: strain_increment, jaumann_rotate, jaumann_rotate_block, elastic_increment, &
-            mean_deviator
+            mean_deviator, volume_ratio, midpoint_increment, corotated_increment
   public :: principal_decompose, principal_compose
 
 contains
@@ -27,6 +36,69 @@ contains
     de(5) = 0.5_wp * dt * (L(1,3) + L(3,1))
     de(6) = 0.5_wp * dt * (L(1,2) + L(2,1))
   end function strain_increment
+
+  !> Volume ratio J = V¹/V⁰ of a step: 1 + Δt tr L (Euler form, summed as
+  !> [[strain_increment]]'s diagonal) or det(I + ½ΔtL)/det(I − ½ΔtL) = det ΔF (midpoint form,
+  !> see the module notes; second order where 1 + Δt tr L is first). J ≤ 0 flags a step that
+  !> inverts the particle (−1 when a midpoint determinant is not positive).
+  pure real(wp) function volume_ratio(dt, L, midpoint) result(j)
+    real(wp), intent(in) :: dt       !! time step [s]
+    real(wp), intent(in) :: L(3,3)   !! velocity gradient [1/s]
+    logical, intent(in) :: midpoint  !! L is the midpoint gradient
+    real(wp) :: a, b
+    if (.not. midpoint) then
+      j = 1.0_wp + (dt * L(1,1) + dt * L(2,2) + dt * L(3,3))
+      return
+    end if
+    a = det_shift(0.5_wp * dt, L)
+    b = det_shift(-0.5_wp * dt, L)
+    j = -1.0_wp
+    if (a > 0.0_wp .and. b > 0.0_wp) j = a / b
+  end function volume_ratio
+
+  !> Increment of the deformation gradient of a midpoint-form step,
+  !> ΔF = (I − ½ΔtL)⁻¹(I + ½ΔtL) (module notes); the identity when I − ½ΔtL is singular
+  !> ([[volume_ratio]] rejects such a step).
+  pure function midpoint_increment(dt, L) result(dF)
+    real(wp), intent(in) :: dt       !! time step [s]
+    real(wp), intent(in) :: L(3,3)   !! midpoint velocity gradient [1/s]
+    real(wp) :: dF(3,3)              !! F¹ = ΔF F⁰
+    real(wp) :: M(3,3), C(3,3), P(3,3), d
+    integer :: i
+    M = -0.5_wp * dt * L; P = 0.5_wp * dt * L
+    do i = 1, 3
+      M(i,i) = M(i,i) + 1.0_wp; P(i,i) = P(i,i) + 1.0_wp
+    end do
+    ! The adjugate: C = det(M) M⁻¹.
+    C(1,1) = M(2,2) * M(3,3) - M(2,3) * M(3,2)
+    C(1,2) = M(1,3) * M(3,2) - M(1,2) * M(3,3)
+    C(1,3) = M(1,2) * M(2,3) - M(1,3) * M(2,2)
+    C(2,1) = M(2,3) * M(3,1) - M(2,1) * M(3,3)
+    C(2,2) = M(1,1) * M(3,3) - M(1,3) * M(3,1)
+    C(2,3) = M(1,3) * M(2,1) - M(1,1) * M(2,3)
+    C(3,1) = M(2,1) * M(3,2) - M(2,2) * M(3,1)
+    C(3,2) = M(1,2) * M(3,1) - M(1,1) * M(3,2)
+    C(3,3) = M(1,1) * M(2,2) - M(1,2) * M(2,1)
+    d = M(1,1) * C(1,1) + M(1,2) * C(2,1) + M(1,3) * C(3,1)
+    if (.not. (abs(d) > 0.0_wp)) then
+      dF = 0.0_wp
+      do i = 1, 3
+        dF(i,i) = 1.0_wp
+      end do
+      return
+    end if
+    dF = matmul(C, P) / d
+  end function midpoint_increment
+
+  ! det(I + c L).
+  pure real(wp) function det_shift(c, L) result(d)
+    real(wp), intent(in) :: c, L(3,3)
+    real(wp) :: a11, a22, a33
+    a11 = 1.0_wp + c * L(1,1); a22 = 1.0_wp + c * L(2,2); a33 = 1.0_wp + c * L(3,3)
+    d = a11 * (a22 * a33 - c * L(2,3) * c * L(3,2)) &
+        - c * L(1,2) * (c * L(2,1) * a33 - c * L(2,3) * c * L(3,1)) &
+        + c * L(1,3) * (c * L(2,1) * c * L(3,2) - a22 * c * L(3,1))
+  end function det_shift
 
   !> Jaumann rotation of a step: σ ← Q σ Qᵀ with Q the Cayley transform of the step's spin,
   !> Q = (I − ½ΔtW)⁻¹(I + ½ΔtW), W = skew(L) (Hughes and Winget 1980). Q is exactly orthogonal,
@@ -110,21 +182,37 @@ contains
   end subroutine rotate_about_z
 
   !> [[jaumann_rotate]] of the stresses s(:, p) of particles 1..n with the velocity gradients
-  !> L(:, :, p), skipping those whose step would invert them, 1 + Δt tr L ≤ 0 (tr L summed as
-  !> [[strain_increment]]'s diagonal is: the models update no stress there). For a model that
-  !> rotates before its increment: one call per block instead of one per particle (the
-  !> rotation, split into its two cases, is inlined into this loop).
-  pure subroutine jaumann_rotate_block(dt, n, L, s)
+  !> L(:, :, p), skipping those whose step would invert them, [[volume_ratio]] ≤ 0 (the models
+  !> update no stress there). For a model that rotates before its increment: one call per
+  !> block instead of one per particle (the rotation, split into its two cases, is inlined
+  !> into this loop).
+  pure subroutine jaumann_rotate_block(dt, n, L, s, midpoint)
     real(wp), intent(in) :: dt           !! time step [s]
     integer, intent(in) :: n             !! number of particles
     real(wp), intent(in) :: L(3, 3, n)   !! velocity gradients [1/s]
     real(wp), intent(inout) :: s(6, n)   !! Cauchy stresses, Voigt [Pa]
+    logical, intent(in) :: midpoint      !! the L are midpoint gradients (module notes)
     integer :: p
     do p = 1, n
-      if (1.0_wp + (dt * L(1,1,p) + dt * L(2,2,p) + dt * L(3,3,p)) <= 0.0_wp) cycle
+      if (volume_ratio(dt, L(:,:,p), midpoint) <= 0.0_wp) cycle
       call jaumann_rotate(dt, L(:,:,p), s(:,p))
     end do
   end subroutine jaumann_rotate_block
+
+  !> The step's strain increment turned by half the step's rotation, Q½ Δε Q½ᵀ with
+  !> Δε = Δt sym L ([[strain_increment]]) and Q½ the Cayley rotation of ½Δt skw L (that of
+  !> [[jaumann_rotate]] over Δt/2). A rate-form model that rotates its stress by Q and adds
+  !> the increment of this one integrates the Jaumann rate to second order under any motion:
+  !> the exact step, Qσ⁰Qᵀ + ∫ Q(τ) C:D Q(τ)ᵀ dτ, is the midpoint rule's Q½ (C:Δε) Q½ᵀ to
+  !> O(Δt³) for an isotropic C, while Δε unturned loses ½Δt²[W, C:D] each step (first order
+  !> wherever strain and spin meet: simple shear). Without spin it is Δε, bitwise.
+  pure function corotated_increment(dt, L) result(de)
+    real(wp), intent(in) :: dt       !! time step [s]
+    real(wp), intent(in) :: L(3,3)   !! velocity gradient [1/s]
+    real(wp) :: de(6)                !! strain increment, Voigt with tensor shears
+    de = strain_increment(dt, L)
+    call jaumann_rotate(0.5_wp * dt, L, de)
+  end function corotated_increment
 
   !> Isotropic elastic stress increment K tr(Δε) I + 2G dev(Δε).
   pure function elastic_increment(K, G, de) result(ds)
