@@ -88,7 +88,9 @@ METRIC_LABEL = {
     "history_l2_velocity": "free-end velocity history error ‖v − v_exact‖ / v₀ [–]",
     "temporal_velocity_l2": "velocity error vs the Δt/8 run ‖v − v_ref‖₂ / v_ref [–]",
     "temporal_displacement_l2": "displacement error vs the Δt/8 run ‖u − u_ref‖₂ / u_ref [–]",
-    "closed_form_error": "stress error |σ − Qσ₀Qᵀ| / |σ₀| [–]"}
+    "closed_form_error": "stress error |σ − Qσ₀Qᵀ| / |σ₀| [–]",
+    "stress_l2": "stress error ‖σ − σ_exact‖₂ / σ_ref [–]",
+    "density_l2": "density error ‖ρ − ρ₀/det F‖₂ / ρ₀ [–]"}
 # Distinguishable curves: colour, line style and marker all vary.
 STYLES = [(plt.get_cmap("tab10").colors[k % 10], ["-", "--", "-.", ":"][k % 4], "osD^v<>"[k % 7])
           for k in range(40)]
@@ -581,6 +583,32 @@ def stress_point_section(s):
     return lines
 
 
+def homogeneous_section(s):
+    """Homogeneous motion (every node driven with v = G x): one plot per motion and measure."""
+    _, conv = by_bench(s, "homogeneous")
+    if not conv:
+        return []
+    lines = ["## Homogeneous motion: rotation, shear and a general gradient, every material class",
+             "", "Every node is driven with v = G x, so every shape family reproduces the "
+             "motion exactly and the error is the time integration's alone, through the whole "
+             "MPM path (docs/benchmarks.md).", ""]
+    exact = ("x = exp(tG) X with the Jaumann solution σ = Q(σ₀ + ∫QᵀSQ dτ)Qᵀ (rate-form "
+             "models), σ(exp(tG)) (neo-Hookean) and ρ₀/det F")
+    groups = [("rotation", "stress", "50° rotations (2D about z, 3D about (1,2,2)/3): stress"),
+              ("shear", "stress", "Simple shear to γ = 1: stress"),
+              ("general", "stress", "A general 3D velocity gradient: stress"),
+              (None, "kinematics", "Density and positions")]
+    for key, what, title in groups:
+        if what == "stress":
+            sel = [c for c in conv if c["id"].split("/")[1].startswith("time_" + key)
+                   and not c["id"].split("/")[1].endswith(("_density", "_position"))]
+        else:
+            sel = [c for c in conv if c["id"].split("/")[1].endswith(("_density", "_position"))]
+        name = f"homogeneous_{key or 'kinematics'}.png"
+        lines += convergence_section(sel, name, title, exact)
+    return lines
+
+
 def main():
     summary_path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(HERE, "summary.json")
     with open(summary_path) as f:
@@ -620,6 +648,7 @@ def main():
             if bench == "vibrating_bar":
                 lines += free_end_section(s)
             lines += convergence_section(time, f"{bench}_time.png", f"{title}: time", exact)
+    lines += homogeneous_section(s)
     lines += andersen_section(s)
     lines += disks_section(s)
     lines += stress_point_section(s)

@@ -17,13 +17,20 @@ module empm_verify_bench
   use empm_mms, only: empm_mms_t
   use empm_mms_linear, only: empm_mms_linear_1d_t, empm_mms_linear_2d_t
   use empm_mms_neohookean, only: empm_mms_neohookean_1d_t, empm_mms_axis_aligned_2d_t
+  use empm_exact_homogeneous, only: empm_homogeneous_t, HOM_JAUMANN, HOM_SMALL_STRAIN, &
+    HOM_NEOHOOKEAN
+  use empm_material_linear_elastic, only: empm_linear_elastic_t
+  use empm_material_mohr_coulomb, only: empm_mohr_coulomb_t
+  use empm_material_drucker_prager, only: empm_drucker_prager_t
+  use empm_material_camclay, only: empm_camclay_t
+  use empm_material_neohookean, only: empm_neohookean_t
   implicit none
   private
   public :: empm_bench_t, bench_known
 
   character(len=*), parameter :: KNOWN = 'dyka vibrating_bar andersen mms_linear_1d '// &
-    'mms_linear_2d mms_neohookean_1d mms_axis_aligned_2d colliding_disks footing '// &
-    'column_collapse'
+    'mms_linear_2d mms_neohookean_1d mms_axis_aligned_2d homogeneous colliding_disks '// &
+    'footing column_collapse'
 
   ! Prandtl strip footing (docs/benchmarks.md): undrained cohesion, footing half-width of the
   ! half model, and the material's P-wave speed (E = 5 MPa, nu = 0.3, rho = 2000 kg/m3).
@@ -88,7 +95,8 @@ contains
       ! 1D uniaxial-strain column along y (plane strain, rollers, nu = 0).
       u(2) = self%column%displacement(X(2), t); v(2) = self%column%velocity(X(2), t)
       s(2) = self%column%stress(X(2), t)
-    case ('mms_linear_1d', 'mms_linear_2d', 'mms_neohookean_1d', 'mms_axis_aligned_2d')
+    case ('mms_linear_1d', 'mms_linear_2d', 'mms_neohookean_1d', 'mms_axis_aligned_2d', &
+          'homogeneous')
       call self%mms%fields(X, t, u, v, F, s, b)
     end select
   end subroutine bench_exact
@@ -162,6 +170,8 @@ contains
         self%sscale = m%E * m%A * 2.0_wp * pi / m%L
         allocate(self%mms, source=m)
       end block
+    case ('homogeneous')
+      call homogeneous()
     case ('colliding_disks')
     case ('footing')
       ! Prandtl: q = (2 + pi) c for a rigid rough strip on weightless Tresca soil.
@@ -178,6 +188,107 @@ contains
     end if
 
   contains
+
+    ! Homogeneous motion (docs/benchmarks.md): G by least squares from the nodes' prescribed
+    ! velocities (every dof of every node prescribed, v = G x to 1e-12), the start stress from
+    ! the particles (uniform), the stress law from the one material.
+    subroutine homogeneous()
+      type(empm_homogeneous_t) :: m
+      real(wp) :: A(3,3), B(3,3), x(3), v(3), s0(6), vmax, res, Dm(3,3), u(3), vv(3), F(3,3), &
+        se(6), bb(3)
+      integer :: nd, node, k, q
+      nd = cs%model%grid%ndim
+      if (size(cs%model%mats) /= 1) then
+        emsg = cs%file//': homogeneous needs one material'; return
+      end if
+      A = 0.0_wp; B = 0.0_wp; vmax = 0.0_wp
+      do node = 1, cs%model%grid%nnode
+        x = 0.0_wp; v = 0.0_wp
+        x = cs%model%grid%node_coord(node)
+        do k = 1, nd
+          if (.not. cs%model%nodes%is_fixed(k, node)) then
+            emsg = cs%file//': homogeneous needs every node driven (&boundary fix = .true. '// &
+              'on every component with velocity_gradient); node '//str(node)//' is free'; return
+          end if
+          v(k) = cs%model%nodes%fixed_velocity(k, node)
+        end do
+        A = A + spread(v, 2, 3) * spread(x, 1, 3)
+        B = B + spread(x, 2, 3) * spread(x, 1, 3)
+        vmax = max(vmax, maxval(abs(v)))
+      end do
+      do k = nd + 1, 3
+        B(k, k) = 1.0_wp
+      end do
+      m%G = matmul(A, inverse3(B))
+      res = 0.0_wp
+      do node = 1, cs%model%grid%nnode
+        x = cs%model%grid%node_coord(node)
+        v = matmul(m%G, x)
+        do k = 1, nd
+          res = max(res, abs(v(k) - cs%model%nodes%fixed_velocity(k, node)))
+        end do
+      end do
+      if (.not. (vmax > 0.0_wp .and. res <= 1.0e-12_wp * vmax)) then
+        emsg = cs%file//': homogeneous needs nodal velocities v = G x (velocity = 0 with '// &
+          'velocity_gradient = G on every node)'; return
+      end if
+      s0 = cs%model%pts%stress(:, 1)
+      do q = 1, np
+        if (any(abs(cs%model%pts%stress(:, q) - s0) > 1.0e-12_wp * maxval(abs(s0)))) then
+          emsg = cs%file//': homogeneous needs a uniform start stress (&particles stress)'; return
+        end if
+      end do
+      m%s0 = s0
+      Dm = 0.5_wp * (m%G + transpose(m%G))
+      select type (mat => cs%model%mats(1)%model)
+      type is (empm_linear_elastic_t)
+        m%lambda = mat%lambda; m%mu = mat%mu
+        m%kind = merge(HOM_JAUMANN, HOM_SMALL_STRAIN, mat%jaumann)
+      type is (empm_mohr_coulomb_t)
+        ! Elastic while the strength is out of reach (the case's cohesion); the metrics show
+        ! a yield as an error that does not converge.
+        m%lambda = mat%K - 2.0_wp * mat%G / 3.0_wp; m%mu = mat%G
+      type is (empm_drucker_prager_t)
+        m%lambda = mat%lambda; m%mu = mat%G
+      type is (empm_camclay_t)
+        ! No closed form under strain (pressure-dependent stiffness): rigid rotation only.
+        if (maxval(abs(Dm)) > 1.0e-12_wp * maxval(abs(m%G))) then
+          emsg = cs%file//': homogeneous with camclay: rigid rotation only (sym G = 0)'; return
+        end if
+      type is (empm_neohookean_t)
+        m%lambda = mat%lambda; m%mu = mat%mu; m%kind = HOM_NEOHOOKEAN
+        if (any(s0 /= 0.0_wp)) then
+          emsg = cs%file//': homogeneous with neohookean: the reference is stress-free'; return
+        end if
+      class default
+        emsg = cs%file//': homogeneous: no exact stress for material model '''// &
+          trim(cs%model%mats(1)%model%name())//''' (linear_elastic, mohr_coulomb, '// &
+          'drucker_prager, neohookean; camclay in rigid rotation)'; return
+      end select
+      ! Scales: the largest exact displacement, velocity and stress component at the end.
+      self%uscale = 0.0_wp; self%vscale = 0.0_wp
+      do q = 1, np
+        call m%fields(cs%model%pts%x0(:, q), cs%run%t_end, u(1:nd), vv(1:nd), F, se, bb(1:nd))
+        self%uscale = max(self%uscale, maxval(abs(u(1:nd))))
+        self%vscale = max(self%vscale, maxval(abs(vv(1:nd))))
+      end do
+      self%sscale = max(maxval(abs(s0)), maxval(abs(m%stress(cs%run%t_end))))
+      if (.not. (self%uscale > 0.0_wp .and. self%sscale > 0.0_wp)) then
+        emsg = cs%file//': homogeneous: no motion or no stress to measure'; return
+      end if
+      allocate(self%mms, source=m)
+    end subroutine homogeneous
+
+    pure function inverse3(M) result(R)
+      real(wp), intent(in) :: M(3,3)
+      real(wp) :: R(3,3)
+      R(1,1) = M(2,2) * M(3,3) - M(2,3) * M(3,2); R(1,2) = M(1,3) * M(3,2) - M(1,2) * M(3,3)
+      R(1,3) = M(1,2) * M(2,3) - M(1,3) * M(2,2); R(2,1) = M(2,3) * M(3,1) - M(2,1) * M(3,3)
+      R(2,2) = M(1,1) * M(3,3) - M(1,3) * M(3,1); R(2,3) = M(1,3) * M(2,1) - M(1,1) * M(2,3)
+      R(3,1) = M(2,1) * M(3,2) - M(2,2) * M(3,1); R(3,2) = M(1,2) * M(3,1) - M(1,1) * M(3,2)
+      R(3,3) = M(1,1) * M(2,2) - M(1,2) * M(2,1)
+      R = R / det3(M)
+    end function inverse3
 
     ! Granular column collapse (docs/benchmarks.md): a 2D column of whole cells under gravity
     ! along -y; its box from the particles' reference positions, checked by its volume.
@@ -258,6 +369,21 @@ contains
         value = weighted_l2(pts%vol0(1:np), pts%x(:, 1:np) - pts%x0(:, 1:np), ue) / self%uscale
       case ('stress_l2')
         value = weighted_l2(pts%vol0(1:np), pts%stress(:, 1:np), se) / self%sscale
+      case ('density_l2')
+        ! Against ρ₀/det F of a manufactured solution, relative to the mean start density.
+        if (.not. allocated(self%mms)) then
+          emsg = 'density_l2 is defined for the manufactured and homogeneous benchmarks only'
+          return
+        end if
+        block
+          real(wp) :: re(1, np), F(3,3), uu(d), vv(d), sv(6), bb(d)
+          do p = 1, np
+            call self%mms%fields(pts%x0(:, p), cs%model%t, uu, vv, F, sv, bb)
+            re(1, p) = pts%m(p) / pts%vol0(p) / det3(F)
+          end do
+          value = weighted_l2(pts%vol0(1:np), reshape(pts%rho(1:np), [1, np]), re) / &
+                  (sum(pts%m(1:np)) / sum(pts%vol0(1:np)))
+        end block
       case ('history_l2_velocity', 'noise_share', 'history_l2_stress', 'overshoot')
         k = merge(2, 1, trim(name) == 'history_l2_stress')
         if (hist%nprobe < k) then

@@ -41,6 +41,9 @@ module empm_verify_spec
     logical :: expect_abort = .false.
     real(wp) :: expect_excess = 0.0_wp
     real(wp) :: expect_order_below = -huge(1.0_wp)
+    character(len=16) :: against = 'reference'   !! time study: errors against a run at an
+                                                 !! 8 times smaller step ('reference') or the
+                                                 !! benchmark's exact solution ('exact')
     integer :: quick_levels = 2                  !! convergence levels run in quick mode
     logical :: quick = .true.                    !! included in the quick subset
   end type empm_verify_spec_t
@@ -54,10 +57,10 @@ contains
     character(len=:), allocatable, intent(out) :: emsg       !! '' or the problem
     character(len=*), parameter :: K = 'benchmark, study, shapes, schemes, levels, cfls, '// &
       'metrics, thresholds, min_order, max_order, max_error, expect_fail, expect_abort, expect_excess, '// &
-      'expect_order_below, label, quick_levels, quick, ppcs'
+      'expect_order_below, label, quick_levels, quick, ppcs, against'
     character(len=32) :: benchmark, metrics(MAXLIST)
     character(len=64) :: expect_fail(MAXLIST)
-    character(len=16) :: study, shapes(MAXLIST), schemes(MAXLIST)
+    character(len=16) :: study, shapes(MAXLIST), schemes(MAXLIST), against
     character(len=32) :: label
     integer :: levels(MAXLIST), quick_levels, u, ios, ppcs(MAXLIST)
     real(wp) :: cfls(MAXLIST), thresholds(MAXLIST), min_order, max_order, expect_excess, &
@@ -66,14 +69,14 @@ contains
     character(len=512) :: msg
     namelist /verify/ benchmark, study, shapes, schemes, levels, cfls, metrics, thresholds, &
       min_order, max_order, max_error, expect_fail, expect_abort, expect_excess, expect_order_below, label, &
-      quick_levels, quick, ppcs
+      quick_levels, quick, ppcs, against
     emsg = ''
     spec%file = path
     benchmark = ''; study = 'matrix'; shapes = ''; schemes = ''; levels = 0; cfls = 0.0_wp
     metrics = ''; thresholds = -huge(1.0_wp); min_order = -huge(1.0_wp); max_order = huge(1.0_wp)
     max_error = huge(1.0_wp)
     quick_levels = 2; quick = .true.; expect_fail = ''; label = ''; expect_abort = .false.
-    expect_excess = 0.0_wp; expect_order_below = -huge(1.0_wp); ppcs = 0
+    expect_excess = 0.0_wp; expect_order_below = -huge(1.0_wp); ppcs = 0; against = 'reference'
     open(newunit=u, file=path, status='old', action='read', iostat=ios, iomsg=msg)
     if (ios /= 0) then
       emsg = path//': cannot open: '//trim(msg); return
@@ -181,6 +184,11 @@ contains
         emsg = path//': group &verify: key ''cfls'': at least two Courant numbers'; return
       end if
       spec%nmetric = 1; spec%metrics(1) = metrics(1)
+      spec%against = lower(against)
+      if (spec%against /= 'reference' .and. spec%against /= 'exact') then
+        emsg = path//': group &verify: key ''against'': expected ''reference'' or ''exact'', '// &
+          'got '''//trim(against)//''''; return
+      end if
     case default
       emsg = path//': group &verify: key ''study'': expected ''matrix'', ''space'', '// &
         '''time'' or ''stress_point'', got '''//trim(study)//''''; return

@@ -254,7 +254,7 @@ contains
       ov%shape = trim(spec%shapes(r%ishape)); ov%scheme = trim(spec%schemes(r%ischeme))
       if (r%ippc > 0) ov%ppc = spec%ppcs(r%ippc)
       if (spec%study == 'space') ov%refine = spec%levels(r%ilevel)
-      if (spec%study == 'time' .and. r%ilevel == 1) then
+      if (spec%study == 'time' .and. r%ilevel == 1 .and. spec%against == 'reference') then
         ! Temporal errors are measured against a run with the same spatial discretisation and
         ! a time step 8 times smaller than the smallest of the study.
         ov%cfl = minval(spec%cfls(1:spec%nlevel)) / 8.0_wp
@@ -276,7 +276,7 @@ contains
       if (.not. root) return
       hlevel = cs%model%grid%hmin()
       if (spec%study == 'time') hlevel = spec%cfls(r%ilevel)
-      if (spec%study == 'time' .and. ran) then
+      if (spec%study == 'time' .and. ran .and. spec%against == 'reference') then
         np = cs%model%pts%np
         if (allocated(ref_u) .and. trim(spec%metrics(1)) == 'velocity_l2') then
           val(1) = weighted_l2(cs%model%pts%vol0(1:np), cs%model%pts%v(:, 1:np), ref_u) / &
@@ -440,7 +440,8 @@ contains
         case default
           call jc%key('parameter'); call jc%str_value('cfl')
         end select
-        if (specs(runs(a)%spec)%study == 'time') then
+        if (specs(runs(a)%spec)%study == 'time' .and. &
+            specs(runs(a)%spec)%against == 'reference') then
           call jc%key('metric'); call jc%str_value('temporal_'//trim(specs(runs(a)%spec)%metrics(1)))
         else
           call jc%key('metric'); call jc%str_value(trim(specs(runs(a)%spec)%metrics(1)))
