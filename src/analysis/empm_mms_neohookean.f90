@@ -5,9 +5,10 @@
 !>
 !> Total Lagrangian momentum balance ρ0 ü = Div P + ρ0 b, with P = J σ F⁻ᵀ the first Piola
 !> stress, Div the reference divergence and b evaluated at the particle's reference position X.
-!> In both problems F is diagonal, F = diag(F_x, F_y, 1) (F_y = 1 in 1D), J = F_x F_y, and
+!> In every problem F is diagonal, F = diag(F_x, F_y, F_z) (F_y = F_z = 1 in 1D, F_z = 1 in 2D),
+!> J = F_x F_y F_z, and
 !> σ = (μ/J)(F Fᵀ − I) + (λ ln J/J) I gives
-!>   σ_xx = [μ(F_x² − 1) + λ ln J]/J,  σ_yy = [μ(F_y² − 1) + λ ln J]/J,  σ_zz = λ ln J/J,
+!>   σ_ii = [μ(F_i² − 1) + λ ln J]/J (σ_zz = λ ln J/J when F_z = 1),
 !>   P_xx = J σ_xx/F_x = μ(F_x − 1/F_x) + λ ln J/F_x   (P_yy likewise, P_xy = P_yx = 0).
 !> P_xx depends on X only through F_x (and on Y only through F_y, which P_xx's X-derivative does
 !> not see), so with ∂(ln J)/∂F_x = 1/F_x:
@@ -23,6 +24,10 @@
 !>   u_x = A sin(2πX/L) sin(cπt/L),  u_y = A sin(2πY/L) sin(cπt/L + π),  ω = cπ/L;
 !> u_x = 0 on X = 0, L and u_y = 0 on Y = 0, L, and P_xy = 0 everywhere: rollers on all four
 !> sides. With A = 0.05 and L = 1, F_x, F_y ∈ [1 − 0.1π, 1 + 0.1π] ≈ [0.69, 1.31].
+!> **3D** ([[empm_mms_axis_aligned_3d_t]], on [0, L]³): the same along each axis with the phases
+!> 0, π and π/2, u_z = A sin(2πZ/L) sin(cπt/L + π/2); J = F_x F_y F_z, the same b_i formula
+!> (ln J's X-derivative is still F_x'/F_x) and σ_zz = [μ(F_z² − 1) + λ ln J]/J; rollers on all
+!> six faces.
 !> The derivation is checked by finite differences of P in tests/unit/test_exact_mms.pf.
 module empm_mms_neohookean
   use empm_kinds, only: wp, pi
@@ -31,7 +36,7 @@ module empm_mms_neohookean
   use empm_tensor, only: identity3
   implicit none
   private
-  public :: empm_mms_neohookean_1d_t, empm_mms_axis_aligned_2d_t
+  public :: empm_mms_neohookean_1d_t, empm_mms_axis_aligned_2d_t, empm_mms_axis_aligned_3d_t
 
   !> 1D neo-Hookean manufactured solution of Steffen et al. (2008).
   type, extends(empm_mms_t) :: empm_mms_neohookean_1d_t
@@ -66,6 +71,17 @@ module empm_mms_neohookean
     procedure :: body_force => n2_body_force
     procedure :: fields => n2_fields
   end type empm_mms_axis_aligned_2d_t
+
+  !> 3D axis-aligned manufactured solution (module notes), neo-Hookean, on [0, L]³.
+  type, extends(empm_mms_t) :: empm_mms_axis_aligned_3d_t
+    real(wp) :: L = 1.0_wp       !! side of the cube [m]
+    real(wp) :: E = 1.0e4_wp     !! small-strain Young's modulus [Pa]
+    real(wp) :: nu = 0.3_wp      !! small-strain Poisson's ratio
+    real(wp) :: rho0 = 1.0_wp    !! reference density [kg/m³]
+    real(wp) :: A = 0.05_wp      !! displacement amplitude [m]
+  contains
+    procedure :: fields => n3_fields
+  end type empm_mms_axis_aligned_3d_t
 
 contains
 
@@ -263,20 +279,54 @@ contains
   ! ---- shared -------------------------------------------------------------------------------
 
   !> Neo-Hookean Cauchy stress for F = diag(fx, fy, 1), Voigt (module notes) [Pa].
-  pure function diagonal_stress(mu, lam, fx, fy) result(s)
+  pure function diagonal_stress(mu, lam, fx, fy, fz) result(s)
     real(wp), intent(in) :: mu  !! shear modulus [Pa]
     real(wp), intent(in) :: lam !! Lamé λ [Pa]
     real(wp), intent(in) :: fx  !! F_xx > 0
     real(wp), intent(in) :: fy  !! F_yy > 0
+    real(wp), intent(in), optional :: fz !! F_zz > 0 (default 1)
     real(wp) :: s(6)            !! stress, Voigt [Pa]
     real(wp) :: J, lnj
     J = fx * fy
+    if (present(fz)) J = J * fz
     lnj = log(J)
     s = 0.0_wp
     s(1) = (mu * (fx**2 - 1.0_wp) + lam * lnj) / J
     s(2) = (mu * (fy**2 - 1.0_wp) + lam * lnj) / J
     s(3) = lam * lnj / J
+    if (present(fz)) s(3) = (mu * (fz**2 - 1.0_wp) + lam * lnj) / J
   end function diagonal_stress
+
+  ! ---- 3D axis-aligned ----------------------------------------------------------------------
+
+  !> [[empm_mms_t]] binding: every exact field at one reference point (module notes).
+  pure subroutine n3_fields(self, X, t, u, v, F, s, b)
+    class(empm_mms_axis_aligned_3d_t), intent(in) :: self !! solution
+    real(wp), intent(in) :: X(:)          !! reference position (3) [m]
+    real(wp), intent(in) :: t             !! time [s]
+    real(wp), intent(out) :: u(:)         !! displacement [m]
+    real(wp), intent(out) :: v(:)         !! velocity [m/s]
+    real(wp), intent(out) :: F(3,3)       !! deformation gradient
+    real(wp), intent(out) :: s(6)         !! Cauchy stress, Voigt [Pa]
+    real(wp), intent(out) :: b(:)         !! body force per unit mass [m/s²]
+    real(wp), parameter :: phase(3) = [0.0_wp, pi, 0.5_wp * pi]
+    real(wp) :: k, w, lam, mu, J
+    integer :: i
+    call empm_lame(self%E, self%nu, lam, mu)
+    k = 2.0_wp * pi / self%L
+    w = sqrt(self%E / self%rho0) * pi / self%L
+    F = identity3()
+    do i = 1, 3
+      u(i) = self%A * sin(k * X(i)) * sin(w * t + phase(i))
+      v(i) = self%A * w * sin(k * X(i)) * cos(w * t + phase(i))
+      F(i,i) = 1.0_wp + self%A * k * cos(k * X(i)) * sin(w * t + phase(i))
+    end do
+    J = F(1,1) * F(2,2) * F(3,3)
+    s = diagonal_stress(mu, lam, F(1,1), F(2,2), F(3,3))
+    do i = 1, 3
+      b(i) = u(i) * body_factor(mu, lam, self%rho0, k, w, F(i,i), J)
+    end do
+  end subroutine n3_fields
 
   !> b_i/u_i = (k²/ρ0)(μ(1 + f⁻²) + λ(1 − ln J) f⁻²) − ω², f = F_ii (module notes) [1/s²].
   pure real(wp) function body_factor(mu, lam, rho0, k, w, f, J)

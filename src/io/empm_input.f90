@@ -547,9 +547,10 @@ contains
     call g%get(p(1), family, e)
     if (e%code /= EMPM_OK) return
     if (allocated(ov%shape)) then
-      ! The study replaces the family: the file's keys of another family do not apply.
+      ! The study replaces the family: the file's keys of another family do not apply (the
+      ! file's family named as it is keeps them, e.g. LME with node-wise γ).
+      if (ov%shape /= family) call g%keep_only(p)
       family = ov%shape
-      call g%keep_only(p)
     end if
     call reg%create_shape(family, cs%model%grid, cs%model%shape, e, g, p)
     if (e%code /= EMPM_OK) return

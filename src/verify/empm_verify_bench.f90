@@ -16,7 +16,8 @@ module empm_verify_bench
   use empm_exact_column, only: empm_column_t, empm_andersen_column
   use empm_mms, only: empm_mms_t
   use empm_mms_linear, only: empm_mms_linear_1d_t, empm_mms_linear_2d_t
-  use empm_mms_neohookean, only: empm_mms_neohookean_1d_t, empm_mms_axis_aligned_2d_t
+  use empm_mms_neohookean, only: empm_mms_neohookean_1d_t, empm_mms_axis_aligned_2d_t, &
+    empm_mms_axis_aligned_3d_t
   use empm_exact_homogeneous, only: empm_homogeneous_t, HOM_JAUMANN, HOM_SMALL_STRAIN, &
     HOM_NEOHOOKEAN
   use empm_material_linear_elastic, only: empm_linear_elastic_t
@@ -29,8 +30,8 @@ module empm_verify_bench
   public :: empm_bench_t, bench_known
 
   character(len=*), parameter :: KNOWN = 'dyka vibrating_bar andersen mms_linear_1d '// &
-    'mms_linear_2d mms_neohookean_1d mms_axis_aligned_2d homogeneous colliding_disks '// &
-    'footing column_collapse'
+    'mms_linear_2d mms_neohookean_1d mms_axis_aligned_2d mms_axis_aligned_3d homogeneous '// &
+    'colliding_disks footing column_collapse'
 
   ! Prandtl strip footing (docs/benchmarks.md): undrained cohesion, footing half-width of the
   ! half model, and the material's P-wave speed (E = 5 MPa, nu = 0.3, rho = 2000 kg/m3).
@@ -96,7 +97,7 @@ contains
       u(2) = self%column%displacement(X(2), t); v(2) = self%column%velocity(X(2), t)
       s(2) = self%column%stress(X(2), t)
     case ('mms_linear_1d', 'mms_linear_2d', 'mms_neohookean_1d', 'mms_axis_aligned_2d', &
-          'homogeneous')
+          'mms_axis_aligned_3d', 'homogeneous')
       call self%mms%fields(X, t, u, v, F, s, b)
     end select
   end subroutine bench_exact
@@ -166,6 +167,16 @@ contains
     case ('mms_axis_aligned_2d')
       block
         type(empm_mms_axis_aligned_2d_t) :: m
+        self%uscale = m%A; self%vscale = m%A * pi * sqrt(m%E / m%rho0) / m%L
+        self%sscale = m%E * m%A * 2.0_wp * pi / m%L
+        allocate(self%mms, source=m)
+      end block
+    case ('mms_axis_aligned_3d')
+      block
+        type(empm_mms_axis_aligned_3d_t) :: m
+        if (cs%model%grid%ndim /= 3) then
+          emsg = cs%file//': mms_axis_aligned_3d is a 3D benchmark'; return
+        end if
         self%uscale = m%A; self%vscale = m%A * pi * sqrt(m%E / m%rho0) / m%L
         self%sscale = m%E * m%A * 2.0_wp * pi / m%L
         allocate(self%mms, source=m)
@@ -251,9 +262,27 @@ contains
       type is (empm_drucker_prager_t)
         m%lambda = mat%lambda; m%mu = mat%G
       type is (empm_camclay_t)
-        ! No closed form under strain (pressure-dependent stiffness): rigid rotation only.
+        ! Isochoric motion (tr G = 0) from inside the yield surface: p' and v stay constant
+        ! (tr S = 0 and the rotation keeps the trace), so K and G do: the Jaumann solution
+        ! with G(p', v) holds while the path stays elastic (the case keeps q below the
+        ! surface; a yield shows as an error that does not converge). The specific volume is
+        ! 1 + e0 (the case gives e0). Under volume change the stiffness varies: no closed form.
+        if (abs(Dm(1,1) + Dm(2,2) + Dm(3,3)) > 1.0e-12_wp * maxval(abs(m%G))) then
+          emsg = cs%file//': homogeneous with camclay: isochoric motion only (tr G = 0)'
+          return
+        end if
         if (maxval(abs(Dm)) > 1.0e-12_wp * maxval(abs(m%G))) then
-          emsg = cs%file//': homogeneous with camclay: rigid rotation only (sym G = 0)'; return
+          if (.not. mat%e0 >= 0.0_wp) then
+            emsg = cs%file//': homogeneous with camclay under strain: give e0'; return
+          end if
+          ! From the model's parameters, not its code: G = 3K(1 − 2ν)/(2(1 + ν)),
+          ! K = v p'/κ (or the constant G given).
+          if (mat%G > 0.0_wp) then
+            m%mu = mat%G
+          else
+            m%mu = 1.5_wp * (1.0_wp - 2.0_wp * mat%nu) / (1.0_wp + mat%nu) * (1.0_wp + mat%e0) &
+                   * (-(s0(1) + s0(2) + s0(3)) / 3.0_wp) / mat%kap
+          end if
         end if
       type is (empm_neohookean_t)
         m%lambda = mat%lambda; m%mu = mat%mu; m%kind = HOM_NEOHOOKEAN
@@ -263,7 +292,7 @@ contains
       class default
         emsg = cs%file//': homogeneous: no exact stress for material model '''// &
           trim(cs%model%mats(1)%model%name())//''' (linear_elastic, mohr_coulomb, '// &
-          'drucker_prager, neohookean; camclay in rigid rotation)'; return
+          'drucker_prager, neohookean; camclay in isochoric motion)'; return
       end select
       ! Scales: the largest exact displacement, velocity and stress component at the end.
       self%uscale = 0.0_wp; self%vscale = 0.0_wp
