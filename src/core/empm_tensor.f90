@@ -6,7 +6,8 @@ module empm_tensor
   use empm_kinds, only: wp
   implicit none
   private
-  public :: identity3, trace3, det3, sym3, voigt_to_mat, mat_to_voigt, voigt_ddot, advance_f
+  public :: identity3, trace3, det3, adjugate3, sym3, voigt_to_mat, mat_to_voigt, voigt_ddot, &
+            advance_f
 
 contains
 
@@ -30,6 +31,22 @@ contains
          - A(1,2) * (A(2,1) * A(3,3) - A(2,3) * A(3,1)) &
          + A(1,3) * (A(2,1) * A(3,2) - A(2,2) * A(3,1))
   end function det3
+
+  !> Adjugate C = det(A) A⁻¹ of a 3×3 matrix (defined for any A); det A =
+  !> A(1,1) C(1,1) + A(1,2) C(2,1) + A(1,3) C(3,1).
+  pure function adjugate3(A) result(C)
+    real(wp), intent(in) :: A(3,3) !! matrix
+    real(wp) :: C(3,3)             !! adjugate
+    C(1,1) = A(2,2) * A(3,3) - A(2,3) * A(3,2)
+    C(1,2) = A(1,3) * A(3,2) - A(1,2) * A(3,3)
+    C(1,3) = A(1,2) * A(2,3) - A(1,3) * A(2,2)
+    C(2,1) = A(2,3) * A(3,1) - A(2,1) * A(3,3)
+    C(2,2) = A(1,1) * A(3,3) - A(1,3) * A(3,1)
+    C(2,3) = A(1,3) * A(2,1) - A(1,1) * A(2,3)
+    C(3,1) = A(2,1) * A(3,2) - A(2,2) * A(3,1)
+    C(3,2) = A(1,2) * A(3,1) - A(1,1) * A(3,2)
+    C(3,3) = A(1,1) * A(2,2) - A(1,2) * A(2,1)
+  end function adjugate3
 
   !> Symmetric part ½(A + Aᵀ) of a 3×3 matrix.
   pure function sym3(A) result(S)

@@ -6,6 +6,7 @@
 module empm_integrator
   use, intrinsic :: iso_fortran_env, only: int64
   use empm_kinds, only: wp
+  use empm_tensor, only: adjugate3
   use empm_error, only: empm_error_t, empm_raise, empm_raise_error, empm_alloc_error, &
                         EMPM_ERR_INPUT
   use empm_family, only: empm_family_t
@@ -838,15 +839,7 @@ contains
         end do
         M(j, j) = M(j, j) + 1.0_wp
       end do
-      C(1, 1) = M(2, 2) * M(3, 3) - M(2, 3) * M(3, 2)
-      C(1, 2) = M(1, 3) * M(3, 2) - M(1, 2) * M(3, 3)
-      C(1, 3) = M(1, 2) * M(2, 3) - M(1, 3) * M(2, 2)
-      C(2, 1) = M(2, 3) * M(3, 1) - M(2, 1) * M(3, 3)
-      C(2, 2) = M(1, 1) * M(3, 3) - M(1, 3) * M(3, 1)
-      C(2, 3) = M(1, 3) * M(2, 1) - M(1, 1) * M(2, 3)
-      C(3, 1) = M(2, 1) * M(3, 2) - M(2, 2) * M(3, 1)
-      C(3, 2) = M(1, 2) * M(3, 1) - M(1, 1) * M(3, 2)
-      C(3, 3) = M(1, 1) * M(2, 2) - M(1, 2) * M(2, 1)
+      C = adjugate3(M)
       det = M(1, 1) * C(1, 1) + M(1, 2) * C(2, 1) + M(1, 3) * C(3, 1)
       ok = det > 0.0_wp
       if (.not. ok) then

@@ -16,6 +16,7 @@
 !> at their boundary (p' = −tr σ/3), not here. All procedures are pure.
 module empm_plasticity
   use empm_kinds, only: wp
+  use empm_tensor, only: adjugate3
   implicit none
   private
   public :: strain_increment, jaumann_rotate, jaumann_rotate_block, elastic_increment, &
@@ -69,16 +70,7 @@ contains
     do i = 1, 3
       M(i,i) = M(i,i) + 1.0_wp; P(i,i) = P(i,i) + 1.0_wp
     end do
-    ! The adjugate: C = det(M) M⁻¹.
-    C(1,1) = M(2,2) * M(3,3) - M(2,3) * M(3,2)
-    C(1,2) = M(1,3) * M(3,2) - M(1,2) * M(3,3)
-    C(1,3) = M(1,2) * M(2,3) - M(1,3) * M(2,2)
-    C(2,1) = M(2,3) * M(3,1) - M(2,1) * M(3,3)
-    C(2,2) = M(1,1) * M(3,3) - M(1,3) * M(3,1)
-    C(2,3) = M(1,3) * M(2,1) - M(1,1) * M(2,3)
-    C(3,1) = M(2,1) * M(3,2) - M(2,2) * M(3,1)
-    C(3,2) = M(1,2) * M(3,1) - M(1,1) * M(3,2)
-    C(3,3) = M(1,1) * M(2,2) - M(1,2) * M(2,1)
+    C = adjugate3(M) ! det(M) M⁻¹
     d = M(1,1) * C(1,1) + M(1,2) * C(2,1) + M(1,3) * C(3,1)
     if (.not. (abs(d) > 0.0_wp)) then
       dF = 0.0_wp

@@ -9,7 +9,7 @@ module empm_verify_bench
   use empm_case, only: empm_case_t
   use empm_history, only: empm_history_t
   use empm_h5, only: hid_t, h5_group, h5_close_group, h5_write, h5_attr
-  use empm_tensor, only: det3, mat_to_voigt, identity3
+  use empm_tensor, only: det3, adjugate3, mat_to_voigt, identity3
   use empm_verify_metrics, only: rms_error, weighted_l2, history_l2, noise_share
   use empm_exact_bar, only: empm_vibrating_bar_t
   use empm_exact_characteristics, only: empm_char_bar_t, empm_dyka_bar
@@ -230,7 +230,7 @@ contains
       do k = nd + 1, 3
         B(k, k) = 1.0_wp
       end do
-      m%G = matmul(A, inverse3(B))
+      m%G = matmul(A, adjugate3(B)) / det3(B)
       res = 0.0_wp
       do node = 1, cs%model%grid%nnode
         x = cs%model%grid%node_coord(node)
@@ -307,17 +307,6 @@ contains
       end if
       allocate(self%mms, source=m)
     end subroutine homogeneous
-
-    pure function inverse3(M) result(R)
-      real(wp), intent(in) :: M(3,3)
-      real(wp) :: R(3,3)
-      R(1,1) = M(2,2) * M(3,3) - M(2,3) * M(3,2); R(1,2) = M(1,3) * M(3,2) - M(1,2) * M(3,3)
-      R(1,3) = M(1,2) * M(2,3) - M(1,3) * M(2,2); R(2,1) = M(2,3) * M(3,1) - M(2,1) * M(3,3)
-      R(2,2) = M(1,1) * M(3,3) - M(1,3) * M(3,1); R(2,3) = M(1,3) * M(2,1) - M(1,1) * M(2,3)
-      R(3,1) = M(2,1) * M(3,2) - M(2,2) * M(3,1); R(3,2) = M(1,2) * M(3,1) - M(1,1) * M(3,2)
-      R(3,3) = M(1,1) * M(2,2) - M(1,2) * M(2,1)
-      R = R / det3(M)
-    end function inverse3
 
     ! Granular column collapse (docs/benchmarks.md): a 2D column of whole cells under gravity
     ! along -y; its box from the particles' reference positions, checked by its volume.
