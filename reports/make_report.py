@@ -609,6 +609,31 @@ def homogeneous_section(s):
     return lines
 
 
+def mutation_section():
+    """The suite's measured power: reports/mutants.json (scripts/mutants, docs/mutants.md)."""
+    path = os.path.join(HERE, "mutants.json")
+    if not os.path.exists(path):
+        return []
+    with open(path) as f:
+        m = json.load(f)
+    sm = m["summary"]
+    lines = ["## The suite's power: mutation score", "",
+             f"`scripts/mutants --{m['mode']}` ({m['generated']}): of {sm['valid']} one-line "
+             f"mutants of `verification/mutants.txt` that build, **{sm['killed'] + sm['timeout']} "
+             f"({sm['share_killed']:.1f} %) are killed** by `empm verify"
+             f"{' --quick' if m['mode'] == 'quick' else ''}`; {sm['invalid']} do not build. "
+             + (f"Only {sm['done']} of the {sm['selected']} selected mutants were run. "
+                if sm["done"] < sm["selected"] else "")
+             + "Survivors (each a bug the suite would let pass):", ""]
+    rows = ["| mutant | file | what it breaks |", "|---|---|---|"]
+    for x in m["mutants"]:
+        if x.get("status") == "survived":
+            rows.append(f"| `{x['id']}` | `{x['file']}:{x.get('line', '')}` | {x['what']} |")
+    if len(rows) == 2:
+        rows = ["None."]
+    return lines + rows + [""]
+
+
 def main():
     summary_path = sys.argv[1] if len(sys.argv) > 1 else os.path.join(HERE, "summary.json")
     with open(summary_path) as f:
@@ -682,6 +707,7 @@ def main():
               "paper says.",
               "- **The Dyka figures' \"left side\"** is the free end x = L in our (and the paper's "
               "section 6.1) coordinates; the paper's figures use the mirrored bar.", ""]
+    lines += mutation_section()
     lines += ["## Summary of every check", "", summary_table(s), ""]
     with open(os.path.join(HERE, "README.md"), "w") as f:
         f.write("\n".join(lines) + "\n")
